@@ -1,0 +1,85 @@
+//! Packs TLD.fmu: modelDescription.xml, binaries/linux64/TLD.so and documentation/index.html
+//! (prose from modelDescription/documentation.html, variable table from the generated table).
+//!
+//! Usage: tld-package <path to libtld_fmu.so> <output .fmu>
+
+use std::io::Write;
+use std::path::Path;
+
+use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType};
+use zip::write::SimpleFileOptions;
+
+const XML: &str = include_str!("../../modelDescription/modelDescription.xml");
+const DOC: &str = include_str!("../../modelDescription/documentation.html");
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+/// The variables as an HTML table, with descriptions taken from the XML.
+fn variable_table() -> String {
+    let mut rows = String::new();
+    for v in VARIABLES {
+        let fmt = |x: Option<f64>| x.map(|x| format!("{x}")).unwrap_or_default();
+        let ty = match v.ty {
+            VarType::Enumeration => {
+                let items: Vec<String> = v.items.iter().map(|(n, val)| format!("{val} = {n}")).collect();
+                format!("Enumeration ({})", items.join(", "))
+            }
+            other => format!("{other:?}"),
+        };
+        let causality = match v.causality {
+            Causality::CalculatedParameter => "calculatedParameter".to_string(),
+            other => format!("{other:?}").to_lowercase(),
+        };
+        rows.push_str(&format!(
+            "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+            escape(v.name),
+            v.vr,
+            causality,
+            escape(&ty),
+            fmt(v.start),
+            fmt(v.min),
+            fmt(v.max),
+            escape(v.description)
+        ));
+    }
+    format!(
+        "<table>\n<tr><th>name</th><th>value reference</th><th>causality</th><th>type</th><th>unit</th><th>start</th><th>min</th><th>max</th><th>description</th></tr>\n{rows}</table>"
+    )
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() != 3 {
+        eprintln!("usage: tld-package <libtld_fmu.so> <TLD.fmu>");
+        std::process::exit(2);
+    }
+    if let Err(e) = pack(Path::new(&args[1]), Path::new(&args[2])) {
+        eprintln!("tld-package: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn pack(library: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let binary = std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+    if let Some(dir) = out.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let doc = DOC.replace("{{VARIABLES}}", &variable_table());
+    let file = std::fs::File::create(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let mut zip = zip::ZipWriter::new(file);
+    let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    zip.start_file("modelDescription.xml", options)?;
+    zip.write_all(XML.as_bytes())?;
+    zip.add_directory("binaries/", options)?;
+    zip.add_directory("binaries/linux64/", options)?;
+    zip.start_file("binaries/linux64/TLD.so", options.unix_permissions(0o755))?;
+    zip.write_all(&binary)?;
+    zip.add_directory("documentation/", options)?;
+    zip.start_file("documentation/index.html", options)?;
+    zip.write_all(doc.as_bytes())?;
+    zip.finish()?;
+    println!("wrote {} ({} bytes of binary)", out.display(), binary.len());
+    Ok(())
+}

@@ -1,0 +1,486 @@
+//! One FMU instance: the FMI 2.0 Co-Simulation call-sequence state machine, variable access
+//! and stepping. Every refused call leaves the instance exactly as it was and says why.
+
+use std::ffi::CString;
+
+use super::logger::Logger;
+use super::params::{Values, calculated};
+use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, index_of, vr};
+use crate::simulation::{Derived, Outputs, Simulation, StepError};
+use crate::solver::SolveError;
+
+/// fmi2Status, as a Rust enum.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Status {
+    Ok = 0,
+    Warning = 1,
+    Discard = 2,
+    Error = 3,
+    Fatal = 4,
+}
+
+/// A call the instance did not carry out, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Refusal {
+    pub status: Status,
+    pub message: String,
+}
+
+pub type Reply = Result<Status, Refusal>;
+
+pub fn refuse(message: impl Into<String>) -> Refusal {
+    Refusal {
+        status: Status::Error,
+        message: message.into(),
+    }
+}
+
+/// States of the FMI 2.0 Co-Simulation state machine this FMU can be in (it never runs
+/// asynchronously, and a refused step leaves it in StepComplete at the step's start).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    Instantiated,
+    InitializationMode,
+    StepComplete,
+    Terminated,
+    /// After an internal error (a caught panic): only fmi2Reset and fmi2FreeInstance work.
+    Broken,
+}
+
+/// Sets of phases in which a function may be called.
+pub mod allow {
+    pub const INSTANTIATED: u8 = 1;
+    pub const INITIALIZATION: u8 = 2;
+    pub const STEP_COMPLETE: u8 = 4;
+    pub const TERMINATED: u8 = 8;
+    pub const ANY: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE | TERMINATED;
+    pub const GET: u8 = INITIALIZATION | STEP_COMPLETE | TERMINATED;
+    pub const SET: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE;
+    pub const STATUS: u8 = STEP_COMPLETE | TERMINATED;
+}
+
+impl Phase {
+    fn bit(self) -> u8 {
+        match self {
+            Phase::Instantiated => allow::INSTANTIATED,
+            Phase::InitializationMode => allow::INITIALIZATION,
+            Phase::StepComplete => allow::STEP_COMPLETE,
+            Phase::Terminated => allow::TERMINATED,
+            Phase::Broken => 0,
+        }
+    }
+
+    fn describe(mask: u8) -> String {
+        let names = [
+            (allow::INSTANTIATED, "Instantiated"),
+            (allow::INITIALIZATION, "InitializationMode"),
+            (allow::STEP_COMPLETE, "StepComplete"),
+            (allow::TERMINATED, "Terminated"),
+        ];
+        let list: Vec<&str> = names
+            .iter()
+            .filter(|(b, _)| mask & b != 0)
+            .map(|(_, n)| *n)
+            .collect();
+        if list.is_empty() {
+            "no state of this FMU".into()
+        } else {
+            list.join(", ")
+        }
+    }
+}
+
+pub const LOG_CATEGORIES: [&str; 3] = ["logStatusError", "logStatusWarning", "logCalls"];
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Experiment {
+    tolerance: Option<f64>,
+    start: f64,
+    stop: Option<f64>,
+}
+
+const MAGIC: u64 = 0x544c_445f_464d_5532;
+
+pub struct Instance {
+    magic: u64,
+    name: CString,
+    logger: Logger,
+    logging_on: bool,
+    log_calls: bool,
+    phase: Phase,
+    values: Values,
+    user_tolerance: bool,
+    experiment: Experiment,
+    time: f64,
+    sim: Option<Simulation>,
+}
+
+impl Instance {
+    pub fn new(name: CString, logger: Logger, logging_on: bool) -> Self {
+        Instance {
+            magic: MAGIC,
+            name,
+            logger,
+            logging_on,
+            log_calls: logging_on,
+            phase: Phase::Instantiated,
+            values: Values::start(),
+            user_tolerance: false,
+            experiment: Experiment::default(),
+            time: 0.0,
+            sim: None,
+        }
+    }
+
+    /// The instance behind a component pointer, if it carries our mark.
+    ///
+    /// # Safety
+    /// `c` must be null or point to readable memory; a pointer we handed out and that was not
+    /// freed is always accepted.
+    pub unsafe fn from_ptr<'a>(c: *mut std::ffi::c_void) -> Option<&'a mut Instance> {
+        let p = c as *mut Instance;
+        if p.is_null() || !p.is_aligned() {
+            return None;
+        }
+        // SAFETY: per the contract above; the mark tells our instances from anything else.
+        unsafe {
+            if (*p).magic == MAGIC {
+                Some(&mut *p)
+            } else {
+                None
+            }
+        }
+    }
+
+    /// Wipe the mark before the memory is freed, so a second free is recognised.
+    pub fn unmark(&mut self) {
+        self.magic = 0;
+    }
+
+    pub fn set_broken(&mut self) {
+        self.phase = Phase::Broken;
+    }
+
+    pub fn log(&self, status: Status, category: &str, message: &str) {
+        let wanted = match status {
+            Status::Ok => self.logging_on && self.log_calls,
+            // Errors and warnings are always reported: the host must learn why a call failed.
+            _ => true,
+        };
+        if wanted {
+            self.logger.log(&self.name, status, category, message);
+        }
+    }
+
+    /// Log a call when the host asked for logCalls.
+    pub fn trace(&self, describe: impl FnOnce() -> String) {
+        if self.logging_on && self.log_calls {
+            self.logger
+                .log(&self.name, Status::Ok, "logCalls", &describe());
+        }
+    }
+
+    pub fn require(&self, allowed: u8, function: &str) -> Result<(), Refusal> {
+        if self.phase == Phase::Broken {
+            return Err(refuse(format!(
+                "{function} refused: an internal error made this instance unusable; call fmi2Reset or fmi2FreeInstance"
+            )));
+        }
+        if self.phase.bit() & allowed == 0 {
+            return Err(refuse(format!(
+                "{function} is not allowed in state {:?} (allowed in: {})",
+                self.phase,
+                Phase::describe(allowed)
+            )));
+        }
+        Ok(())
+    }
+
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Reply {
+        let mut unknown = Vec::new();
+        let mut calls = self.log_calls;
+        if categories.is_empty() {
+            calls = on;
+        }
+        for c in categories {
+            match c.as_str() {
+                "logCalls" => calls = on,
+                "logStatusError" | "logStatusWarning" => {}
+                other => unknown.push(other.chars().take(64).collect::<String>()),
+            }
+        }
+        self.logging_on = on;
+        self.log_calls = calls;
+        if unknown.is_empty() {
+            Ok(Status::Ok)
+        } else {
+            self.log(
+                Status::Warning,
+                "logStatusWarning",
+                &format!(
+                    "fmi2SetDebugLogging: unknown log categories {unknown:?} ignored (known: {})",
+                    LOG_CATEGORIES.join(", ")
+                ),
+            );
+            Ok(Status::Warning)
+        }
+    }
+
+    pub fn setup_experiment(
+        &mut self,
+        tolerance: Option<f64>,
+        start: f64,
+        stop: Option<f64>,
+    ) -> Reply {
+        self.require(allow::INSTANTIATED, "fmi2SetupExperiment")?;
+        if !start.is_finite() {
+            return Err(refuse(format!(
+                "fmi2SetupExperiment: startTime {start} is not finite"
+            )));
+        }
+        if let Some(stop) = stop
+            && (!stop.is_finite() || stop < start)
+        {
+            return Err(refuse(format!(
+                "fmi2SetupExperiment: stopTime {stop} must be finite and not before startTime {start}"
+            )));
+        }
+        if let Some(tol) = tolerance
+            && !(tol.is_finite() && tol > 0.0)
+        {
+            return Err(refuse(format!(
+                "fmi2SetupExperiment: tolerance {tol} must be positive and finite"
+            )));
+        }
+        // Keep the tolerance inside the range the solver.tolerance parameter declares.
+        let range = index_of(vr::SOLVER_TOLERANCE).and_then(|i| VARIABLES.get(i));
+        let tolerance = tolerance.map(|t| {
+            let lo = range.and_then(|v| v.min).unwrap_or(t);
+            let hi = range.and_then(|v| v.max).unwrap_or(t);
+            t.clamp(lo, hi)
+        });
+        self.experiment = Experiment {
+            tolerance,
+            start,
+            stop,
+        };
+        Ok(Status::Ok)
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> Reply {
+        self.require(allow::INSTANTIATED, "fmi2EnterInitializationMode")?;
+        self.time = self.experiment.start;
+        self.phase = Phase::InitializationMode;
+        Ok(Status::Ok)
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> Reply {
+        self.require(allow::INITIALIZATION, "fmi2ExitInitializationMode")?;
+        let (sim, warnings) = self.build()?;
+        self.sim = Some(sim);
+        self.phase = Phase::StepComplete;
+        for w in &warnings {
+            self.log(Status::Warning, "logStatusWarning", w);
+        }
+        Ok(if warnings.is_empty() {
+            Status::Ok
+        } else {
+            Status::Warning
+        })
+    }
+
+    pub fn terminate(&mut self) -> Reply {
+        self.require(allow::STEP_COMPLETE, "fmi2Terminate")?;
+        self.phase = Phase::Terminated;
+        Ok(Status::Ok)
+    }
+
+    pub fn reset(&mut self) -> Reply {
+        if self.phase != Phase::Broken {
+            self.require(allow::ANY, "fmi2Reset")?;
+        }
+        self.phase = Phase::Instantiated;
+        self.values = Values::start();
+        self.user_tolerance = false;
+        self.experiment = Experiment::default();
+        self.time = 0.0;
+        self.sim = None;
+        Ok(Status::Ok)
+    }
+
+    fn build(&self) -> Result<(Simulation, Vec<String>), Refusal> {
+        let config = self
+            .values
+            .config(self.experiment.tolerance, self.user_tolerance);
+        Simulation::new(config).map_err(|e| refuse(format!("the parameters are inconsistent: {e}")))
+    }
+
+    /// Calculated parameters and outputs now: from the running simulation, or during
+    /// initialisation from one built on the parameters set so far.
+    fn current(&self) -> Result<(Derived, Outputs), Refusal> {
+        let inputs = self.values.inputs();
+        match &self.sim {
+            Some(sim) => Ok((sim.derived(), sim.outputs(&inputs))),
+            None => {
+                let (sim, _) = self.build()?;
+                Ok((sim.derived(), sim.outputs(&inputs)))
+            }
+        }
+    }
+
+    fn variable(vr: u32, function: &str) -> Result<(usize, &'static Variable), Refusal> {
+        index_of(vr)
+            .and_then(|i| VARIABLES.get(i).map(|v| (i, v)))
+            .ok_or_else(|| refuse(format!("{function}: unknown value reference {vr}")))
+    }
+
+    fn type_matches(var: &Variable, wanted: VarType) -> bool {
+        var.ty == wanted || (wanted == VarType::Integer && var.ty == VarType::Enumeration)
+    }
+
+    /// Values of the variables `vrs` of type `ty` (integers as f64), handed to `put` by position.
+    pub fn get(
+        &self,
+        vrs: &[u32],
+        ty: VarType,
+        function: &str,
+        mut put: impl FnMut(usize, f64),
+    ) -> Reply {
+        self.require(allow::GET, function)?;
+        let mut cache: Option<(Derived, Outputs)> = None;
+        for (k, &r) in vrs.iter().enumerate() {
+            let (index, var) = Self::variable(r, function)?;
+            if !Self::type_matches(var, ty) {
+                return Err(refuse(format!(
+                    "{function}: '{}' (value reference {r}) is of type {:?}",
+                    var.name, var.ty
+                )));
+            }
+            let value = match var.causality {
+                Causality::Parameter | Causality::Input | Causality::Local => self.values.at(index),
+                Causality::CalculatedParameter | Causality::Output => {
+                    let (derived, outputs) = match &cache {
+                        Some(c) => c,
+                        None => cache.insert(self.current()?),
+                    };
+                    calculated(r, derived, outputs)
+                        .ok_or_else(|| refuse(format!("{function}: '{}' has no value", var.name)))?
+                }
+            };
+            put(k, value);
+        }
+        Ok(Status::Ok)
+    }
+
+    /// Set the variables `vrs` of type `ty`: all are checked before any is changed.
+    pub fn set(&mut self, vrs: &[u32], values: &[f64], ty: VarType, function: &str) -> Reply {
+        self.require(allow::SET, function)?;
+        for (&r, &value) in vrs.iter().zip(values) {
+            self.check_set(r, value, ty, function)?;
+        }
+        for (&r, &value) in vrs.iter().zip(values) {
+            if let Some(index) = index_of(r) {
+                self.values.set_at(index, value);
+            }
+            if r == vr::SOLVER_TOLERANCE {
+                self.user_tolerance = true;
+            }
+        }
+        Ok(Status::Ok)
+    }
+
+    fn check_set(&self, r: u32, value: f64, ty: VarType, function: &str) -> Result<(), Refusal> {
+        let (_, var) = Self::variable(r, function)?;
+        if !Self::type_matches(var, ty) {
+            return Err(refuse(format!(
+                "{function}: '{}' (value reference {r}) is of type {:?}",
+                var.name, var.ty
+            )));
+        }
+        match var.causality {
+            Causality::Parameter => {
+                let before_init =
+                    matches!(self.phase, Phase::Instantiated | Phase::InitializationMode);
+                if !before_init && var.variability != Variability::Tunable {
+                    return Err(refuse(format!(
+                        "{function}: '{}' is a fixed parameter and can only be set before fmi2ExitInitializationMode",
+                        var.name
+                    )));
+                }
+            }
+            Causality::Input => {}
+            _ => {
+                return Err(refuse(format!(
+                    "{function}: '{}' is computed by the FMU and cannot be set",
+                    var.name
+                )));
+            }
+        }
+        if let Some(reason) = var.reject(value) {
+            return Err(refuse(format!("{function}: {reason}")));
+        }
+        Ok(())
+    }
+
+    pub fn do_step(&mut self, t: f64, h: f64) -> Reply {
+        self.require(allow::STEP_COMPLETE, "fmi2DoStep")?;
+        if !(h.is_finite() && h > 0.0) {
+            return Err(refuse(format!(
+                "fmi2DoStep: communicationStepSize {h} must be positive and finite"
+            )));
+        }
+        if !t.is_finite() {
+            return Err(refuse(format!(
+                "fmi2DoStep: currentCommunicationPoint {t} is not finite"
+            )));
+        }
+        // Hosts accumulate time with rounding: accept a small mismatch, refuse a real one.
+        let slack = 1e-9 * self.time.abs().max(1.0) + 1e-6 * h;
+        if (t - self.time).abs() > slack {
+            return Err(refuse(format!(
+                "fmi2DoStep: currentCommunicationPoint {t} does not match the FMU's time {} (the FMU cannot jump in time)",
+                self.time
+            )));
+        }
+        if let Some(stop) = self.experiment.stop
+            && t + h > stop + 1e-9 * stop.abs().max(1.0) + 1e-6 * h
+        {
+            return Err(refuse(format!(
+                "fmi2DoStep: the step to {} would pass the stop time {stop}",
+                t + h
+            )));
+        }
+        let inputs = self.values.inputs();
+        let sim = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| refuse("fmi2DoStep: no simulation (not initialised)"))?;
+        match sim.step(t, h, &inputs) {
+            Ok(_) => {
+                self.time = t + h;
+                Ok(Status::Ok)
+            }
+            Err(e) => {
+                let status = match e {
+                    StepError::Solver(SolveError::TooManySteps { .. }) => Status::Discard,
+                    _ => Status::Error,
+                };
+                let hint = if status == Status::Discard {
+                    " The state is left at the start of the step; retry with a smaller communication step."
+                } else {
+                    " The state is left at the start of the step."
+                };
+                Err(Refusal {
+                    status,
+                    message: format!("fmi2DoStep from t = {t} by {h}: {e}.{hint}"),
+                })
+            }
+        }
+    }
+
+    pub fn last_successful_time(&self) -> Result<f64, Refusal> {
+        self.require(allow::STATUS, "fmi2GetRealStatus")?;
+        Ok(self.time)
+    }
+}

@@ -1,0 +1,10 @@
+//! The only place that speaks FMI: exported fmi2* functions (thin, panic-safe), the instance and
+//! its call-sequence state machine, variable access and logging.
+
+mod exports;
+mod instance;
+mod logger;
+mod params;
+pub mod vars;
+
+pub use instance::Status;

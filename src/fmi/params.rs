@@ -1,0 +1,127 @@
+//! From the variable values the host set to the physics configuration. The only place that
+//! maps FMI variable names onto the simulation's inputs and outputs.
+
+use super::vars::{VARIABLES, index_of, vr};
+use crate::physics::geometry::Tank;
+use crate::physics::laws::{DampingLaw, LambdaRange};
+use crate::simulation::{AmplitudeSource, Config, Derived, Inputs, Method, Outputs};
+
+/// Values of all variables, in the order of `VARIABLES` (integers and enumerations as f64).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Values(Vec<f64>);
+
+impl Values {
+    /// Start values from the model description (NaN where a variable has none).
+    pub fn start() -> Self {
+        Values(
+            VARIABLES
+                .iter()
+                .map(|v| v.start.unwrap_or(f64::NAN))
+                .collect(),
+        )
+    }
+
+    pub fn get(&self, vr: u32) -> f64 {
+        index_of(vr)
+            .and_then(|i| self.0.get(i))
+            .copied()
+            .unwrap_or(f64::NAN)
+    }
+
+    pub fn at(&self, index: usize) -> f64 {
+        self.0.get(index).copied().unwrap_or(f64::NAN)
+    }
+
+    pub fn set_at(&mut self, index: usize, value: f64) {
+        if let Some(slot) = self.0.get_mut(index) {
+            *slot = value;
+        }
+    }
+
+    pub fn inputs(&self) -> Inputs {
+        Inputs {
+            a: self.get(vr::BASE_A),
+            v: self.get(vr::BASE_V),
+            x: self.get(vr::BASE_X),
+        }
+    }
+
+    /// The configuration these values describe. `tolerance` is the experiment's tolerance, used
+    /// unless the user set solver.tolerance explicitly.
+    pub fn config(&self, tolerance: Option<f64>, user_tolerance: bool) -> Config {
+        let g = |r| self.get(r);
+        let damping = if g(vr::DAMPING) == 1.0 {
+            DampingLaw::Constant(g(vr::ZETA))
+        } else {
+            DampingLaw::Nsd {
+                c: g(vr::NSD_C),
+                p: g(vr::NSD_P),
+            }
+        };
+        let amplitude = if g(vr::AMPLITUDE) == 2.0 {
+            AmplitudeSource::Tracked {
+                tau: g(vr::AMPLITUDE_TAU),
+                prior: g(vr::A_E),
+            }
+        } else {
+            AmplitudeSource::Fixed(g(vr::A_E))
+        };
+        let rtol = match tolerance {
+            Some(tol) if !user_tolerance => tol,
+            _ => g(vr::SOLVER_TOLERANCE),
+        };
+        let method = if g(vr::SOLVER) == 2.0 {
+            Method::Rk4 {
+                step: g(vr::SOLVER_FIXED_STEP),
+            }
+        } else {
+            Method::DormandPrince {
+                rtol,
+                max_step: g(vr::SOLVER_MAX_STEP),
+            }
+        };
+        Config {
+            tank: Tank {
+                length: g(vr::TANK_LENGTH),
+                breadth: g(vr::TANK_BREADTH),
+                depth: g(vr::TANK_DEPTH),
+                density: g(vr::LIQUID_DENSITY),
+                g: g(vr::G),
+            },
+            tanks: g(vr::TANKS) as u32,
+            eta: g(vr::ETA),
+            phi: g(vr::PHI),
+            damping,
+            lambda: LambdaRange {
+                min: g(vr::LAMBDA_MIN),
+                max: g(vr::LAMBDA_MAX),
+            },
+            amplitude,
+            x0: g(vr::SLOSH_X0),
+            v0: g(vr::SLOSH_V0),
+            method,
+            max_substeps: g(vr::SOLVER_MAX_SUBSTEPS) as u64,
+        }
+    }
+}
+
+/// The value of a calculated parameter or output, by value reference.
+pub fn calculated(vr: u32, derived: &Derived, outputs: &Outputs) -> Option<f64> {
+    Some(match vr {
+        vr::OMEGA_F => derived.omega_f,
+        vr::MASS_LIQUID => derived.mass_liquid,
+        vr::MASS_SLOSH => derived.mass_slosh,
+        vr::MASS_INACTIVE => derived.mass_inactive,
+        vr::FORCE => outputs.force,
+        vr::FORCE_MEAN => outputs.force_mean,
+        vr::BASE_SHEAR => outputs.base_shear,
+        vr::SLOSH_X => outputs.x,
+        vr::SLOSH_V => outputs.v,
+        vr::ENERGY_INPUT => outputs.energy_input,
+        vr::ENERGY_DISSIPATED => outputs.energy_dissipated,
+        vr::ENERGY_STORED => outputs.energy_stored,
+        vr::A_E_ESTIMATE => outputs.amplitude,
+        vr::ZETA_EFFECTIVE => outputs.zeta,
+        _ => return None,
+    })
+}

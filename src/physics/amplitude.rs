@@ -1,0 +1,102 @@
+//! Online estimate of the excitation amplitude A_e from the base motion (MODEL.md section 2:
+//! nobody hands A_e over in a co-simulation).
+//!
+//! For harmonic base motion x_b = A sin(w t): <v^2> = w^2 A^2/2 and <a^2> = w^4 A^2/2, so
+//! A = sqrt(2) <v^2> / sqrt(<a^2>) whatever w is. The mean squares come from two cascaded
+//! first-order low-pass filters (time constant tau each: ripple at 2w falls as 1/(2 w tau)^2),
+//! normalised by the filters' response to a constant so early estimates are not biased low.
+//! When the host never sets the base velocity, the velocity is rebuilt from the acceleration by
+//! a leaky integrator v' = a - w_c v, and its known gain w / sqrt(w^2 + w_c^2) is undone.
+
+/// Two cascaded first-order low-pass filters of one signal, sampled once per interval.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct MeanSquare {
+    first: f64,
+    second: f64,
+}
+
+impl MeanSquare {
+    fn update(&mut self, alpha: f64, sample: f64) {
+        self.first += alpha * (sample - self.first);
+        self.second += alpha * (self.first - self.second);
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct AmplitudeTracker {
+    tau: f64,
+    leak: f64,
+    prior: f64,
+    rebuilt_v: f64,
+    measured_v_seen: bool,
+    ms_v: MeanSquare,
+    ms_a: MeanSquare,
+    weight: MeanSquare,
+}
+
+impl AmplitudeTracker {
+    /// `tau`: filter time constant [s]; `leak`: corner w_c of the velocity rebuild [rad/s];
+    /// `prior`: the estimate before any data.
+    pub fn new(tau: f64, leak: f64, prior: f64) -> Self {
+        AmplitudeTracker {
+            tau,
+            leak,
+            prior,
+            rebuilt_v: 0.0,
+            measured_v_seen: false,
+            ms_v: MeanSquare::default(),
+            ms_a: MeanSquare::default(),
+            weight: MeanSquare::default(),
+        }
+    }
+
+    /// Take in the base acceleration and velocity held over an interval of length `h`.
+    pub fn update(&mut self, h: f64, accel: f64, velocity: f64) {
+        let alpha = -(-h / self.tau).exp_m1();
+        if velocity != 0.0 && !self.measured_v_seen {
+            // The host drives base.v: restart the velocity statistics from the measured signal.
+            self.measured_v_seen = true;
+            self.ms_v = MeanSquare::default();
+            self.ms_a = MeanSquare::default();
+            self.weight = MeanSquare::default();
+        }
+        let v = if self.measured_v_seen {
+            velocity
+        } else {
+            self.rebuilt_v
+        };
+        self.ms_v.update(alpha, v * v);
+        self.ms_a.update(alpha, accel * accel);
+        self.weight.update(alpha, 1.0);
+        // Exact advance of v' = a - w_c v with a held.
+        let decay = (-self.leak * h).exp();
+        self.rebuilt_v = self.rebuilt_v * decay - accel * (-self.leak * h).exp_m1() / self.leak;
+    }
+
+    /// The current amplitude estimate [m].
+    pub fn estimate(&self) -> f64 {
+        let w = self.weight.second;
+        if w <= 0.0 {
+            return self.prior;
+        }
+        let (v2, a2) = (self.ms_v.second / w, self.ms_a.second / w);
+        if !(a2 > 0.0 && v2 > 0.0) {
+            return self.prior;
+        }
+        let estimate = if self.measured_v_seen {
+            std::f64::consts::SQRT_2 * v2 / a2.sqrt()
+        } else {
+            // The rebuilt velocity has <v^2> = <a^2> / (w^2 + w_c^2): solve for w^2.
+            let w2 = a2 / v2 - self.leak * self.leak;
+            if w2 <= 0.0 {
+                return self.prior;
+            }
+            std::f64::consts::SQRT_2 * a2.sqrt() / w2
+        };
+        if estimate.is_finite() {
+            estimate
+        } else {
+            self.prior
+        }
+    }
+}

@@ -1,0 +1,7 @@
+//! The physics of a tuned liquid damper, restated from the seed with MODEL.md's corrections.
+//! Plain Rust: no FFI and nothing of FMI here.
+
+pub mod amplitude;
+pub mod geometry;
+pub mod laws;
+pub mod nonlinear;
