@@ -292,3 +292,175 @@ impl Simulation {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config() -> Config {
+        Config {
+            tank: Tank::TABLE_2_1,
+            tanks: 1,
+            eta: 2.0,
+            phi: 1.0,
+            damping: DampingLaw::Nsd { c: 0.5, p: 0.35 },
+            lambda: LambdaRange {
+                min: 1e-3,
+                max: 0.1,
+            },
+            amplitude: AmplitudeSource::Fixed(0.005),
+            x0: 0.0,
+            v0: 0.0,
+            method: Method::DormandPrince {
+                rtol: 1e-10,
+                max_step: 0.0,
+            },
+            max_substeps: 100_000,
+        }
+    }
+
+    /// Free decay of the linear limit against the closed-form damped oscillation.
+    #[test]
+    fn linear_free_decay_matches_closed_form() {
+        let cfg = Config {
+            eta: 1.0,
+            phi: 0.0,
+            damping: DampingLaw::Constant(0.02),
+            x0: 0.01,
+            ..config()
+        };
+        let (mut sim, _) = Simulation::new(cfg).expect("config");
+        let w = sim.derived().omega_f;
+        let wd = w * (1.0 - 0.02f64 * 0.02).sqrt();
+        let h = 0.01;
+        let mut worst: f64 = 0.0;
+        for k in 0..2000 {
+            sim.step(k as f64 * h, h, &Inputs::default()).expect("step");
+            let t = (k + 1) as f64 * h;
+            let exact =
+                0.01 * (-0.02 * w * t).exp() * ((wd * t).cos() + 0.02 * w / wd * (wd * t).sin());
+            worst = worst.max((sim.outputs(&Inputs::default()).x - exact).abs());
+        }
+        assert!(worst < 1e-8 * 0.01, "worst error {worst}");
+    }
+
+    /// energy.input = energy.stored + energy.dissipated, and dissipation never decreases.
+    #[test]
+    fn energy_balance_under_harmonic_forcing() {
+        let cfg = Config {
+            x0: 0.02,
+            ..config()
+        };
+        let (mut sim, _) = Simulation::new(cfg).expect("config");
+        let w = 1.1 * sim.derived().omega_f;
+        let mut last_dissipated = 0.0;
+        let h = 0.005;
+        for k in 0..4000 {
+            let t = k as f64 * h;
+            let inputs = Inputs {
+                a: -w * w * 0.005 * (w * t).sin(),
+                ..Inputs::default()
+            };
+            sim.step(t, h, &inputs).expect("step");
+            let o = sim.outputs(&inputs);
+            let residual = (o.energy_input - o.energy_stored - o.energy_dissipated).abs();
+            assert!(
+                residual < 1e-8 * o.energy_input.abs().max(1e-6),
+                "step {k}: residual {residual}"
+            );
+            assert!(o.energy_dissipated >= last_dissipated);
+            last_dissipated = o.energy_dissipated;
+        }
+        assert!(last_dissipated > 0.0);
+    }
+
+    #[test]
+    fn a_refused_step_changes_nothing() {
+        let cfg = Config {
+            max_substeps: 3,
+            x0: 0.05,
+            ..config()
+        };
+        let (mut sim, _) = Simulation::new(cfg).expect("config");
+        let before = sim.clone();
+        let r = sim.step(
+            0.0,
+            50.0,
+            &Inputs {
+                a: 1.0,
+                ..Inputs::default()
+            },
+        );
+        assert!(
+            matches!(r, Err(StepError::Solver(SolveError::TooManySteps { .. }))),
+            "{r:?}"
+        );
+        assert_eq!(sim, before);
+    }
+
+    #[test]
+    fn tracked_amplitude_settles_within_five_percent() {
+        for rebuild in [false, true] {
+            for ratio in [0.5, 1.0, 2.0] {
+                let cfg = Config {
+                    amplitude: AmplitudeSource::Tracked {
+                        tau: 0.0,
+                        prior: 0.001,
+                    },
+                    ..config()
+                };
+                let (mut sim, _) = Simulation::new(cfg).expect("config");
+                let w = ratio * sim.derived().omega_f;
+                let amp = 0.005;
+                let h = 0.01;
+                for k in 0..6000 {
+                    let t = k as f64 * h;
+                    let v = if rebuild {
+                        0.0
+                    } else {
+                        w * amp * (w * t).cos()
+                    };
+                    let inputs = Inputs {
+                        a: -w * w * amp * (w * t).sin(),
+                        v,
+                        x: amp * (w * t).sin(),
+                    };
+                    sim.step(t, h, &inputs).expect("step");
+                    if k > 4000 {
+                        let est = sim.outputs(&inputs).amplitude;
+                        assert!(
+                            (est / amp - 1.0).abs() < 0.05,
+                            "w/wf {ratio} rebuild {rebuild}: {est}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn inconsistent_configurations_are_refused() {
+        let bad = Config {
+            lambda: LambdaRange { min: 0.2, max: 0.1 },
+            ..config()
+        };
+        assert!(Simulation::new(bad).is_err());
+        let deep = Config {
+            tank: Tank {
+                depth: 0.3,
+                ..Tank::TABLE_2_1
+            },
+            ..config()
+        };
+        assert!(Simulation::new(deep).is_err());
+        let (_, warnings) = Simulation::new(Config {
+            tank: Tank {
+                depth: 0.05,
+                ..Tank::TABLE_2_1
+            },
+            ..config()
+        })
+        .expect("valid but deep");
+        assert_eq!(warnings.len(), 1);
+    }
+}

@@ -13,7 +13,9 @@ const XML: &str = include_str!("../../modelDescription/modelDescription.xml");
 const DOC: &str = include_str!("../../modelDescription/documentation.html");
 
 fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 /// The variables as an HTML table, with descriptions taken from the XML.
@@ -23,7 +25,11 @@ fn variable_table() -> String {
         let fmt = |x: Option<f64>| x.map(|x| format!("{x}")).unwrap_or_default();
         let ty = match v.ty {
             VarType::Enumeration => {
-                let items: Vec<String> = v.items.iter().map(|(n, val)| format!("{val} = {n}")).collect();
+                let items: Vec<String> = v
+                    .items
+                    .iter()
+                    .map(|(n, val)| format!("{val} = {n}"))
+                    .collect();
                 format!("Enumeration ({})", items.join(", "))
             }
             other => format!("{other:?}"),
@@ -62,12 +68,14 @@ fn main() {
 }
 
 fn pack(library: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
-    let binary = std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+    let binary =
+        std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir)?;
     }
     let doc = DOC.replace("{{VARIABLES}}", &variable_table());
-    let file = std::fs::File::create(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let file =
+        std::fs::File::create(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     zip.start_file("modelDescription.xml", options)?;

@@ -60,3 +60,47 @@ impl Tank {
         self.mode(1)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// MODEL.md section 1 check values for the seed's Table 2.1 tank.
+    #[test]
+    fn table_2_1_check_values() {
+        let t = Tank::TABLE_2_1;
+        assert!((t.liquid_mass() - 1.68).abs() < 1e-12);
+        let m1 = t.mode(1);
+        assert!(
+            (m1.mass / t.liquid_mass() - 0.7923).abs() < 5e-5,
+            "{}",
+            m1.mass / t.liquid_mass()
+        );
+        assert!((m1.omega - 5.6389).abs() < 5e-5, "{}", m1.omega);
+        assert!((m1.omega / (2.0 * PI) - 0.8975).abs() < 5e-5);
+        let m2 = t.mode(2);
+        assert!((m2.mass / t.liquid_mass() - 0.075).abs() < 5e-4);
+        assert!((m2.omega - 15.62).abs() < 5e-3, "{}", m2.omega);
+        let m3 = t.mode(3);
+        assert!((m3.mass / t.liquid_mass() - 0.021).abs() < 5e-4);
+        assert!((m3.omega - 23.11).abs() < 5e-3, "{}", m3.omega);
+        let sum: f64 = (1..=200).map(|n| t.mode(n).mass).sum::<f64>() / t.liquid_mass();
+        assert!((sum - 0.909).abs() < 1e-3, "{sum}");
+    }
+
+    /// MODEL.md section 6 sizing at h/a = 0.1.
+    #[test]
+    fn sizing_at_depth_ratio_one_tenth() {
+        for (a, hz) in [(0.24, 1.0), (0.95, 0.5), (5.9, 0.2), (23.8, 0.1)] {
+            let t = Tank {
+                length: a,
+                breadth: 1.0,
+                depth: 0.1 * a,
+                density: 1000.0,
+                g: 9.81,
+            };
+            let f = t.fundamental().omega / (2.0 * PI);
+            assert!((f / hz - 1.0).abs() < 0.01, "a = {a}: {f} Hz");
+        }
+    }
+}

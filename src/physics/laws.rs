@@ -45,3 +45,35 @@ pub fn nsd_kappa(lambda: f64) -> f64 {
         2.52 * lambda.powf(0.25)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const RANGE: LambdaRange = LambdaRange {
+        min: 1e-3,
+        max: 0.1,
+    };
+
+    #[test]
+    fn nsd_damping_law_and_clamp() {
+        let law = DampingLaw::Nsd { c: 0.5, p: 0.35 };
+        // Lambda = 0.005/0.25 = 0.02: 0.5 * 0.02^0.35.
+        let z = law.zeta(0.005, 0.25, RANGE);
+        assert!((z - 0.5 * (0.02f64).ln().mul_add(0.35, 0.0).exp()).abs() < 1e-15);
+        assert!((z - 0.127_154).abs() < 1e-6, "{z}");
+        // Below and above the fitted range the law is held at the ends.
+        assert_eq!(law.zeta(0.0, 0.25, RANGE), 0.5 * 1e-3f64.powf(0.35));
+        assert_eq!(law.zeta(10.0, 0.25, RANGE), 0.5 * 0.1f64.powf(0.35));
+        assert_eq!(law.zeta(f64::NAN, 0.25, RANGE), law.zeta(0.0, 0.25, RANGE));
+        assert_eq!(DampingLaw::Constant(0.02).zeta(1.0, 0.25, RANGE), 0.02);
+    }
+
+    #[test]
+    fn kappa_branches_meet_at_three_percent() {
+        assert!((nsd_kappa(0.03 - 1e-12) - 1.0489).abs() < 1e-4);
+        assert!((nsd_kappa(0.03) - 1.0488).abs() < 1e-4);
+        // Extrapolated far below the fitted range the fit would soften (kappa < 1): why Lambda is clamped.
+        assert!(nsd_kappa(1e-5) < 1.0 && nsd_kappa(1e-3) > 1.0);
+    }
+}

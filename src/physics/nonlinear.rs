@@ -7,7 +7,10 @@ use crate::solver::Rhs;
 /// |xi|^(2 eta - 2), specialised so integer exponents cost a multiplication, not a powf.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Power {
-    Zero,
+    /// phi = 0: no hardening.
+    None,
+    /// eta = 1: |xi|^0 = 1, a constant extra stiffness phi.
+    Constant,
     Int(i32),
     Real(f64),
 }
@@ -27,8 +30,10 @@ impl PowerLaw {
     /// `eta` >= 1 (real), `phi` >= 0, `length` = a.
     pub fn new(omega_f: f64, phi: f64, eta: f64, length: f64) -> Self {
         let p = 2.0 * eta - 2.0;
-        let power = if phi == 0.0 || p == 0.0 {
-            Power::Zero
+        let power = if phi == 0.0 {
+            Power::None
+        } else if p == 0.0 {
+            Power::Constant
         } else if p.fract() == 0.0 && p <= 64.0 {
             Power::Int(p as i32)
         } else {
@@ -48,7 +53,8 @@ impl PowerLaw {
     pub fn hardening(&self, x: f64) -> f64 {
         let xi = (x * self.inv_half_length).abs();
         match self.power {
-            Power::Zero => 0.0,
+            Power::None => 0.0,
+            Power::Constant => self.phi,
             Power::Int(n) => self.phi * xi.powi(n),
             Power::Real(p) => self.phi * xi.powf(p),
         }
@@ -114,5 +120,57 @@ impl Rhs<{ state::DIM }> for NonlinearTld {
         dy[state::WORK_IN] = -self.base_acceleration * v;
         dy[state::DISSIPATED] = self.c * v * v;
         dy[state::IMPULSE] = f;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn direct(x: f64, w: f64, phi: f64, eta: f64, a: f64) -> f64 {
+        w * w * x * (1.0 + phi * (2.0 * x / a).abs().powf(2.0 * eta - 2.0))
+    }
+
+    #[test]
+    fn phi_is_odd_and_matches_eq_2_13() {
+        for eta in [1.0, 1.5, 2.0, 2.5, 3.0, 5.0, 7.3, 10.0] {
+            let law = PowerLaw::new(5.6389, 1.3, eta, 0.25);
+            for x in [0.0, 1e-4, 0.01, 0.05, 0.125, 0.2] {
+                let f = law.force(x);
+                assert_eq!(law.force(-x), -f, "odd at eta {eta}, x {x}");
+                let want = direct(x, 5.6389, 1.3, eta, 0.25);
+                assert!(
+                    (f - want).abs() <= 1e-13 * want.abs().max(1e-300),
+                    "eta {eta} x {x}: {f} vs {want}"
+                );
+            }
+            // At the wall (xi = 1) the stiffness is (1 + phi) times linear, for every eta.
+            let wall = law.force(0.125) / (5.6389f64.powi(2) * 0.125);
+            assert!((wall - 2.3).abs() < 1e-12, "eta {eta}: {wall}");
+        }
+    }
+
+    #[test]
+    fn potential_is_the_integral_of_phi() {
+        for eta in [1.0, 2.0, 3.5, 10.0] {
+            let law = PowerLaw::new(4.0, 0.7, eta, 0.5);
+            for x in [-0.3, -0.1, 0.02, 0.2, 0.26] {
+                let d = 1e-6;
+                let slope = (law.potential(x + d) - law.potential(x - d)) / (2.0 * d);
+                assert!(
+                    (slope - law.force(x)).abs() < 1e-6 * law.force(x).abs().max(1e-3),
+                    "eta {eta} x {x}"
+                );
+            }
+            assert_eq!(law.potential(0.0), 0.0);
+        }
+    }
+
+    #[test]
+    fn linear_when_phi_is_zero_or_eta_is_one() {
+        // phi = 0: the linear oscillator whatever eta.
+        assert_eq!(PowerLaw::new(2.0, 0.0, 3.0, 1.0).force(0.3), 4.0 * 0.3);
+        // eta = 1: |xi|^0 = 1, so Phi = omega^2 (1 + phi) x, still linear.
+        assert!((PowerLaw::new(2.0, 2.0, 1.0, 1.0).force(0.3) - 4.0 * 3.0 * 0.3).abs() < 1e-15);
     }
 }

@@ -93,8 +93,9 @@ impl<const N: usize> Dopri5<N> {
         let zero = [0.0; N];
         let d0 = self.norm(y, &zero, &zero);
         let d1 = self.norm(f0, y, y);
+        // From rest the state says nothing of the time scale: let the second estimate decide.
         let h0 = if d0 < 1e-5 || d1 < 1e-5 {
-            1e-6 * span
+            0.01 * span
         } else {
             0.01 * d0 / d1
         };

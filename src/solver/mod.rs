@@ -54,3 +54,95 @@ pub struct SolveStats {
 pub(crate) fn all_finite<const N: usize>(y: &[f64; N]) -> bool {
     y.iter().all(|v| v.is_finite())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// x'' = -w^2 x: exact solution x = cos(w t), v = -w sin(w t).
+    struct Oscillator(f64);
+
+    impl Rhs<2> for Oscillator {
+        fn eval(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+            dy[0] = y[1];
+            dy[1] = -self.0 * self.0 * y[0];
+        }
+    }
+
+    fn error_after(y: &[f64; 2], w: f64, t: f64) -> f64 {
+        ((y[0] - (w * t).cos()).powi(2) + ((y[1] + w * (w * t).sin()) / w).powi(2)).sqrt()
+    }
+
+    #[test]
+    fn dopri5_meets_its_tolerance_over_many_intervals() {
+        let w = 5.6389;
+        for rtol in [1e-6, 1e-9, 1e-12] {
+            let mut dp = Dopri5::new(rtol, [1.0, w], f64::INFINITY, 100_000);
+            let mut y = [1.0, 0.0];
+            let h = 0.01;
+            for k in 0..1000 {
+                dp.integrate(&Oscillator(w), k as f64 * h, (k + 1) as f64 * h, &mut y)
+                    .expect("step");
+            }
+            let e = error_after(&y, w, 10.0);
+            // Global error grows with the number of steps: allow 100 x the local tolerance.
+            assert!(e < 100.0 * rtol, "rtol {rtol}: error {e}");
+            assert!(
+                e > 1e-3 * rtol || rtol < 1e-11,
+                "suspiciously exact at rtol {rtol}: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn rk4_is_fourth_order() {
+        let w = 5.6389;
+        let run = |step: f64| {
+            let mut y = [1.0, 0.0];
+            Rk4 {
+                max_step: step,
+                max_steps: 1_000_000,
+            }
+            .integrate(&Oscillator(w), 0.0, 5.0, &mut y)
+            .expect("run");
+            error_after(&y, w, 5.0)
+        };
+        let ratio = run(0.01) / run(0.005);
+        assert!((ratio - 16.0).abs() < 1.0, "error ratio {ratio}");
+    }
+
+    #[test]
+    fn work_bound_refuses_and_leaves_state_alone() {
+        let mut dp = Dopri5::new(1e-12, [1.0, 1.0], f64::INFINITY, 5);
+        let mut y = [1.0, 0.0];
+        let r = dp.integrate(&Oscillator(5.0), 0.0, 100.0, &mut y);
+        assert!(
+            matches!(r, Err(SolveError::TooManySteps { limit: 5, .. })),
+            "{r:?}"
+        );
+        assert_eq!(y, [1.0, 0.0]);
+        let r = Rk4 {
+            max_step: 1e-3,
+            max_steps: 10,
+        }
+        .integrate(&Oscillator(5.0), 0.0, 1.0, &mut y);
+        assert!(matches!(r, Err(SolveError::TooManySteps { .. })));
+        assert_eq!(y, [1.0, 0.0]);
+    }
+
+    /// y' = y^2 blows up at t = 1: the integrator must stop with an error, not return garbage.
+    #[test]
+    fn blow_up_is_reported() {
+        struct BlowUp;
+        impl Rhs<1> for BlowUp {
+            fn eval(&self, _t: f64, y: &[f64; 1], dy: &mut [f64; 1]) {
+                dy[0] = y[0] * y[0];
+            }
+        }
+        let mut dp = Dopri5::new(1e-8, [1.0], f64::INFINITY, 100_000);
+        let mut y = [1.0];
+        let r = dp.integrate(&BlowUp, 0.0, 2.0, &mut y);
+        assert!(r.is_err(), "{r:?} {y:?}");
+        assert_eq!(y, [1.0]);
+    }
+}

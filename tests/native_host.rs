@@ -1,0 +1,597 @@
+//! The FMU driven through its C entry points by a native host (dlopen of the built library).
+
+mod common;
+
+use common::*;
+use std::ffi::CString;
+use tld_fmu::fmi::vars::{GUID, vr};
+use tld_fmu::physics::geometry::Tank;
+use tld_fmu::physics::laws::{DampingLaw, LambdaRange};
+use tld_fmu::simulation::{AmplitudeSource, Config, Inputs, Method, Simulation};
+
+/// The FMI layer adds nothing and loses nothing: the same run through the C interface and
+/// directly through the simulation is bit-identical.
+#[test]
+fn fmi_layer_is_transparent() {
+    let mut inst = Instance::new("transparent");
+    inst.initialise();
+    let x_fmu = inst.run_harmonic(500, 0.01);
+    let (mut sim, _) = Simulation::new(Config {
+        tank: Tank::TABLE_2_1,
+        tanks: 1,
+        eta: 2.0,
+        phi: 1.0,
+        damping: DampingLaw::Nsd { c: 0.5, p: 0.35 },
+        lambda: LambdaRange {
+            min: 1e-3,
+            max: 0.1,
+        },
+        amplitude: AmplitudeSource::Fixed(0.005),
+        x0: 0.0,
+        v0: 0.0,
+        method: Method::DormandPrince {
+            rtol: 1e-10,
+            max_step: 0.0,
+        },
+        max_substeps: 100_000,
+    })
+    .expect("defaults");
+    let w = 6.0;
+    let mut t = 0.0;
+    for _ in 0..500 {
+        let inputs = Inputs {
+            a: -w * w * 0.004 * f64::sin(w * t),
+            ..Inputs::default()
+        };
+        sim.step(t, 0.01, &inputs).expect("step");
+        t += 0.01;
+    }
+    let direct = sim.outputs(&Inputs::default()).x;
+    assert_eq!(x_fmu.to_bits(), direct.to_bits(), "{x_fmu} vs {direct}");
+    assert!(x_fmu.abs() > 1e-3, "the run must actually slosh: {x_fmu}");
+}
+
+#[test]
+fn calculated_parameters_and_outputs_in_initialization_mode() {
+    let inst = Instance::new("init-values");
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.set_integer(vr::TANKS, 3), OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.set_real(vr::SLOSH_X0, 0.01), OK);
+    let (s, m) = inst.get_real(vr::MASS_LIQUID);
+    assert_eq!(s, OK);
+    assert!((m - 3.0 * 1.68).abs() < 1e-12);
+    let (_, ms) = inst.get_real(vr::MASS_SLOSH);
+    assert!((ms / m - 0.7923).abs() < 5e-5);
+    let (_, w) = inst.get_real(vr::OMEGA_F);
+    assert!((w - 5.6389).abs() < 5e-5);
+    let (_, x) = inst.get_real(vr::SLOSH_X);
+    assert_eq!(x, 0.01);
+    let (_, f) = inst.get_real(vr::FORCE);
+    // force = m w^2 x (1 + phi (2x/a)^2) at rest.
+    let want = ms * w * w * 0.01 * (1.0 + (0.02f64 / 0.25).powi(2));
+    assert!((f - want).abs() < 1e-9 * want, "{f} vs {want}");
+    assert_eq!(inst.set_real(vr::BASE_A, 2.0), OK);
+    let (_, shear) = inst.get_real(vr::BASE_SHEAR);
+    let (_, inactive) = inst.get_real(vr::MASS_INACTIVE);
+    assert!((shear - (f - inactive * 2.0)).abs() < 1e-12);
+}
+
+/// Functions whose legality depends on the state, with valid arguments.
+#[derive(Clone, Copy, Debug)]
+enum Call {
+    SetupExperiment,
+    EnterInit,
+    ExitInit,
+    Terminate,
+    DoStep,
+    GetReal,
+    SetInput,
+    SetFixedParameter,
+    GetRealStatus,
+    CancelStep,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum State {
+    Instantiated,
+    Initialization,
+    StepComplete,
+    Terminated,
+}
+
+const CALLS: [Call; 10] = [
+    Call::SetupExperiment,
+    Call::EnterInit,
+    Call::ExitInit,
+    Call::Terminate,
+    Call::DoStep,
+    Call::GetReal,
+    Call::SetInput,
+    Call::SetFixedParameter,
+    Call::GetRealStatus,
+    Call::CancelStep,
+];
+
+/// FMI 2.0 Co-Simulation calling sequence (standard section 4.2.4), for the states this FMU has.
+fn allowed(call: Call, state: State) -> bool {
+    use State::*;
+    match call {
+        Call::SetupExperiment | Call::EnterInit => state == Instantiated,
+        Call::ExitInit => state == Initialization,
+        Call::Terminate | Call::DoStep => state == StepComplete,
+        Call::GetReal => matches!(state, Initialization | StepComplete | Terminated),
+        Call::SetInput => matches!(state, Instantiated | Initialization | StepComplete),
+        Call::SetFixedParameter => matches!(state, Instantiated | Initialization),
+        Call::GetRealStatus => matches!(state, StepComplete | Terminated),
+        Call::CancelStep => false,
+    }
+}
+
+fn function_name(call: Call) -> &'static str {
+    match call {
+        Call::SetupExperiment => "fmi2SetupExperiment",
+        Call::EnterInit => "fmi2EnterInitializationMode",
+        Call::ExitInit => "fmi2ExitInitializationMode",
+        Call::Terminate => "fmi2Terminate",
+        Call::DoStep => "fmi2DoStep",
+        Call::GetReal => "fmi2GetReal",
+        Call::SetInput | Call::SetFixedParameter => "fmi2SetReal",
+        Call::GetRealStatus => "fmi2GetRealStatus",
+        Call::CancelStep => "fmi2CancelStep",
+    }
+}
+
+fn drive(inst: &Instance, state: State) {
+    if state == State::Instantiated {
+        return;
+    }
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.enter(), OK);
+    if state == State::Initialization {
+        return;
+    }
+    assert_eq!(inst.exit(), OK);
+    if state == State::Terminated {
+        assert_eq!(inst.terminate(), OK);
+    }
+}
+
+fn perform(inst: &mut Instance, call: Call) -> u32 {
+    unsafe {
+        match call {
+            Call::SetupExperiment => inst.setup(),
+            Call::EnterInit => inst.enter(),
+            Call::ExitInit => inst.exit(),
+            Call::Terminate => inst.terminate(),
+            Call::DoStep => inst.lib.fmi2DoStep(inst.c, inst.time, 0.01, 1),
+            Call::GetReal => inst.get_real(vr::SLOSH_X).0,
+            // The value set is the one the reference run uses first, so a legal set is harmless.
+            Call::SetInput => inst.set_real(vr::BASE_A, 0.0),
+            Call::SetFixedParameter => inst.set_real(vr::ETA, 2.0),
+            Call::GetRealStatus => {
+                let mut t = 0.0;
+                inst.lib.fmi2GetRealStatus(
+                    inst.c,
+                    fmi_sys::fmi2::fmi2StatusKind_fmi2LastSuccessfulTime,
+                    &mut t,
+                )
+            }
+            Call::CancelStep => inst.lib.fmi2CancelStep(inst.c),
+        }
+    }
+}
+
+/// Carry on from `state` to a finished harmonic run; the result must not depend on what
+/// illegal calls came before.
+fn finish(inst: &mut Instance, state: State) -> f64 {
+    match state {
+        State::Instantiated => inst.initialise(),
+        State::Initialization => assert_eq!(inst.exit(), OK),
+        State::StepComplete => {}
+        State::Terminated => return inst.get_real(vr::SLOSH_X).1,
+    }
+    inst.run_harmonic(200, 0.01)
+}
+
+#[test]
+fn every_illegal_call_is_refused_logged_and_harmless() {
+    let states = [
+        State::Instantiated,
+        State::Initialization,
+        State::StepComplete,
+        State::Terminated,
+    ];
+    let mut refused = 0;
+    for state in states {
+        let reference = {
+            let mut clean = Instance::new(&format!("clean-{state:?}"));
+            drive(&clean, state);
+            finish(&mut clean, state)
+        };
+        for call in CALLS {
+            if allowed(call, state) {
+                let mut inst = Instance::new(&format!("legal-{state:?}-{call:?}"));
+                drive(&inst, state);
+                assert_eq!(
+                    perform(&mut inst, call),
+                    OK,
+                    "{call:?} must be allowed in {state:?}: {:?}",
+                    inst.logs()
+                );
+                continue;
+            }
+            let name = format!("illegal-{state:?}-{call:?}");
+            let mut inst = Instance::new(&name);
+            drive(&inst, state);
+            let status = perform(&mut inst, call);
+            assert_eq!(status, ERROR, "{call:?} in {state:?} must be refused");
+            let logs = inst.logs();
+            assert!(!logs.is_empty(), "{call:?} in {state:?}: no log message");
+            assert!(
+                logs.iter().any(|m| m.contains(function_name(call))),
+                "{call:?}: {logs:?}"
+            );
+            let after = finish(&mut inst, state);
+            assert_eq!(
+                after.to_bits(),
+                reference.to_bits(),
+                "{call:?} in {state:?} changed the instance"
+            );
+            refused += 1;
+        }
+    }
+    assert_eq!(
+        refused, 25,
+        "the table above has 6 + 6 + 5 + 8 illegal (state, call) pairs"
+    );
+}
+
+#[test]
+fn bad_values_are_refused_logged_and_change_nothing() {
+    let reference = {
+        let mut clean = Instance::new("bad-values-clean");
+        clean.initialise();
+        clean.run_harmonic(100, 0.01);
+        clean.run_harmonic(100, 0.01)
+    };
+    let mut inst = Instance::new("bad-values");
+    inst.initialise();
+    inst.run_harmonic(100, 0.01);
+    let before = inst.logs().len();
+    let lib = inst.lib;
+    let c = inst.c;
+    let mut count = 0;
+    let mut expect = |status: u32, want: u32, what: &str| {
+        assert_eq!(status, want, "{what}");
+        count += 1;
+    };
+    unsafe {
+        expect(inst.set_real(vr::BASE_A, f64::NAN), ERROR, "NaN input");
+        expect(inst.set_real(vr::BASE_A, f64::INFINITY), ERROR, "Inf input");
+        expect(
+            inst.set_real(vr::BASE_V, f64::NEG_INFINITY),
+            ERROR,
+            "-Inf input",
+        );
+        expect(inst.set_real(9999, 1.0), ERROR, "unknown value reference");
+        expect(
+            inst.get_real(9999).0,
+            ERROR,
+            "unknown value reference (get)",
+        );
+        expect(
+            inst.set_real(vr::ETA, 3.0),
+            ERROR,
+            "fixed parameter after initialisation",
+        );
+        expect(inst.set_real(vr::FORCE, 3.0), ERROR, "setting an output");
+        expect(
+            inst.set_real(vr::OMEGA_F, 3.0),
+            ERROR,
+            "setting a calculated parameter",
+        );
+        expect(
+            inst.set_integer(vr::BASE_A, 1),
+            ERROR,
+            "integer setter on a Real",
+        );
+        expect(
+            lib.fmi2SetReal(c, std::ptr::null(), 1, &1.0),
+            ERROR,
+            "null vr",
+        );
+        expect(
+            lib.fmi2SetReal(c, &vr::BASE_A, 1, std::ptr::null()),
+            ERROR,
+            "null value",
+        );
+        expect(
+            lib.fmi2GetReal(c, &vr::FORCE, 1, std::ptr::null_mut()),
+            ERROR,
+            "null output",
+        );
+        // Two values, the second bad: neither may be applied.
+        let vrs = [vr::BASE_A, vr::BASE_V];
+        expect(
+            lib.fmi2SetReal(c, vrs.as_ptr(), 2, [5.0, f64::NAN].as_ptr()),
+            ERROR,
+            "partly bad array",
+        );
+        expect(lib.fmi2DoStep(c, inst.time, 0.0, 1), ERROR, "zero step");
+        expect(
+            lib.fmi2DoStep(c, inst.time, -0.01, 1),
+            ERROR,
+            "negative step",
+        );
+        expect(lib.fmi2DoStep(c, inst.time, f64::NAN, 1), ERROR, "NaN step");
+        expect(
+            lib.fmi2DoStep(c, inst.time + 0.5, 0.01, 1),
+            ERROR,
+            "time mismatch",
+        );
+        expect(
+            lib.fmi2DoStep(c, f64::INFINITY, 0.01, 1),
+            ERROR,
+            "infinite time",
+        );
+        let names = [
+            CString::new("logCalls").unwrap(),
+            CString::new("%s%n%s nonsense").unwrap(),
+        ];
+        let ptrs = [names[0].as_ptr(), names[1].as_ptr()];
+        expect(
+            lib.fmi2SetDebugLogging(c, 0, 2, ptrs.as_ptr()),
+            WARNING,
+            "unknown log category",
+        );
+        expect(
+            lib.fmi2SetDebugLogging(c, 0, 1, std::ptr::null()),
+            ERROR,
+            "null categories",
+        );
+        expect(
+            lib.fmi2GetFMUstate(c, &mut std::ptr::null_mut()),
+            ERROR,
+            "FMU state not offered",
+        );
+        expect(
+            lib.fmi2GetDerivatives(c, std::ptr::null_mut(), 0),
+            ERROR,
+            "Model Exchange function",
+        );
+        expect(
+            lib.fmi2DoStep(std::ptr::null_mut(), 0.0, 0.01, 1),
+            ERROR,
+            "null instance",
+        );
+    }
+    let logs = inst.logs();
+    // Every refusal on this instance logged a reason (the null instance cannot log).
+    assert!(
+        logs.len() - before >= count - 1,
+        "{count} refusals, {} messages: {logs:?}",
+        logs.len() - before
+    );
+    assert!(
+        logs.iter().any(|m| m.contains("%s%n%s nonsense")),
+        "untrusted text is echoed verbatim: {logs:?}"
+    );
+    assert!(
+        logs.iter().any(|m| m.contains("must be finite")),
+        "{logs:?}"
+    );
+    let after = inst.run_harmonic(100, 0.01);
+    assert_eq!(
+        after.to_bits(),
+        reference.to_bits(),
+        "bad calls changed the instance"
+    );
+}
+
+#[test]
+fn out_of_range_and_inconsistent_parameters() {
+    let inst = Instance::new("ranges");
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.set_real(vr::TANK_LENGTH, -1.0), ERROR);
+    assert_eq!(inst.set_real(vr::ETA, 0.5), ERROR);
+    assert_eq!(inst.set_real(vr::PHI, -1.0), ERROR);
+    assert_eq!(
+        inst.set_integer(vr::DAMPING, 7),
+        ERROR,
+        "not an enumeration item"
+    );
+    assert_eq!(
+        inst.set_integer(vr::MODEL, 1),
+        ERROR,
+        "Linear is not offered yet"
+    );
+    assert_eq!(inst.set_integer(vr::TANKS, 0), ERROR);
+    assert_eq!(
+        inst.get_real(vr::TANK_LENGTH).0,
+        ERROR,
+        "getters are not allowed before initialisation mode"
+    );
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(
+        inst.get_real(vr::TANK_LENGTH),
+        (OK, 0.25),
+        "refused values were not stored"
+    );
+    // Each value in range, together inconsistent: refused at exit, still in initialisation mode.
+    assert_eq!(inst.set_real(vr::LAMBDA_MIN, 0.09), OK);
+    assert_eq!(inst.set_real(vr::LAMBDA_MAX, 0.05), OK);
+    assert_eq!(inst.exit(), ERROR);
+    assert!(
+        inst.logs().iter().any(|m| m.contains("lambda.min")),
+        "{:?}",
+        inst.logs()
+    );
+    assert_eq!(inst.set_real(vr::LAMBDA_MAX, 0.1), OK);
+    assert_eq!(inst.exit(), OK);
+}
+
+#[test]
+fn instantiate_refuses_what_it_cannot_serve() {
+    let lib = library();
+    let callbacks = callbacks();
+    let name = CString::new("refuse").unwrap();
+    let guid = CString::new(GUID).unwrap();
+    let wrong = CString::new("{00000000-0000-0000-0000-000000000000}").unwrap();
+    unsafe {
+        let c = lib.fmi2Instantiate(
+            name.as_ptr(),
+            fmi_sys::fmi2::fmi2Type_fmi2ModelExchange,
+            guid.as_ptr(),
+            std::ptr::null(),
+            &*callbacks,
+            0,
+            0,
+        );
+        assert!(c.is_null(), "Model Exchange");
+        let c = lib.fmi2Instantiate(
+            name.as_ptr(),
+            fmi_sys::fmi2::fmi2Type_fmi2CoSimulation,
+            wrong.as_ptr(),
+            std::ptr::null(),
+            &*callbacks,
+            0,
+            0,
+        );
+        assert!(c.is_null(), "wrong GUID");
+        let c = lib.fmi2Instantiate(
+            std::ptr::null(),
+            fmi_sys::fmi2::fmi2Type_fmi2CoSimulation,
+            guid.as_ptr(),
+            std::ptr::null(),
+            &*callbacks,
+            0,
+            0,
+        );
+        assert!(c.is_null(), "null name");
+        let c = lib.fmi2Instantiate(
+            name.as_ptr(),
+            fmi_sys::fmi2::fmi2Type_fmi2CoSimulation,
+            guid.as_ptr(),
+            std::ptr::null(),
+            std::ptr::null(),
+            0,
+            0,
+        );
+        assert!(c.is_null(), "null callbacks");
+        // A null logger is fine: errors then go nowhere, but nothing crashes.
+        let quiet = Box::new(fmi_sys::fmi2::fmi2CallbackFunctions {
+            logger: None,
+            ..*callbacks
+        });
+        let c = lib.fmi2Instantiate(
+            name.as_ptr(),
+            fmi_sys::fmi2::fmi2Type_fmi2CoSimulation,
+            guid.as_ptr(),
+            std::ptr::null(),
+            &*quiet,
+            0,
+            1,
+        );
+        assert!(!c.is_null());
+        assert_eq!(lib.fmi2DoStep(c, 0.0, 0.1, 0), ERROR);
+        lib.fmi2FreeInstance(c);
+        // Freeing twice or freeing null is survived.
+        lib.fmi2FreeInstance(std::ptr::null_mut());
+    }
+    let logs: Vec<String> = Instance::new("refuse-probe").logs();
+    assert!(logs.is_empty());
+}
+
+#[test]
+fn reset_returns_to_a_fresh_instance() {
+    let mut inst = Instance::new("reset");
+    inst.initialise();
+    let first = inst.run_harmonic(100, 0.01);
+    assert_eq!(inst.reset(), OK);
+    inst.time = 0.0;
+    inst.initialise();
+    assert_eq!(inst.run_harmonic(100, 0.01).to_bits(), first.to_bits());
+}
+
+#[test]
+fn too_many_substeps_is_a_discard_that_keeps_the_state() {
+    let mut inst = Instance::new("discard");
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.set_integer(vr::SOLVER_MAX_SUBSTEPS, 5), OK);
+    assert_eq!(inst.exit(), OK);
+    assert_eq!(inst.set_real(vr::BASE_A, 1.0), OK);
+    let x0 = inst.get_real(vr::SLOSH_X).1;
+    assert_eq!(inst.do_step(30.0), DISCARD);
+    assert!(
+        inst.logs()
+            .iter()
+            .any(|m| m.contains("smaller communication step")),
+        "{:?}",
+        inst.logs()
+    );
+    assert_eq!(inst.get_real(vr::SLOSH_X).1, x0);
+    let mut t = 0.0;
+    unsafe {
+        inst.lib.fmi2GetRealStatus(
+            inst.c,
+            fmi_sys::fmi2::fmi2StatusKind_fmi2LastSuccessfulTime,
+            &mut t,
+        )
+    };
+    assert_eq!(t, 0.0);
+    assert_eq!(
+        inst.do_step(1e-4),
+        OK,
+        "a smaller step goes through within 5 substeps: {:?}",
+        inst.logs()
+    );
+}
+
+#[test]
+fn concurrent_instances_match_serial_runs() {
+    let serial: Vec<u64> = (0..4)
+        .map(|k| {
+            let mut inst = Instance::new(&format!("serial-{k}"));
+            inst.initialise();
+            inst.run_harmonic(300 + 50 * k, 0.01).to_bits()
+        })
+        .collect();
+    let threads: Vec<_> = (0..4usize)
+        .map(|k| {
+            std::thread::spawn(move || {
+                let mut inst = Instance::new(&format!("thread-{k}"));
+                inst.initialise();
+                inst.run_harmonic(300 + 50 * k, 0.01).to_bits()
+            })
+        })
+        .collect();
+    let parallel: Vec<u64> = threads
+        .into_iter()
+        .map(|t| t.join().expect("thread"))
+        .collect();
+    assert_eq!(serial, parallel);
+}
+
+/// The library exports the 44 fmi2 functions and nothing of its own, except `callback_log`:
+/// a #[no_mangle] function inside the fmi-sys crate (its logger shim for FMU importers), which
+/// rustc exports from every cdylib that links fmi-sys. It is never called by this FMU.
+#[test]
+fn exports_only_fmi2_functions() {
+    let out = std::process::Command::new("nm")
+        .args(["-D", "--defined-only"])
+        .arg(library_path())
+        .output()
+        .expect("nm (binutils) must be installed");
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let symbols: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.split_whitespace().nth(2))
+        .collect();
+    let fmi: Vec<&&str> = symbols.iter().filter(|s| s.starts_with("fmi2")).collect();
+    let other: Vec<&&str> = symbols.iter().filter(|s| !s.starts_with("fmi2")).collect();
+    assert_eq!(fmi.len(), 44, "{fmi:?}");
+    assert_eq!(other, vec![&"callback_log"], "unexpected exports");
+}
