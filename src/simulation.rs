@@ -1,7 +1,7 @@
 //! The small interface between the FMI layer and the physics: a configured damper that steps
 //! over communication intervals with held inputs and reports its outputs. Knows no FMI.
 
-use crate::physics::amplitude::AmplitudeTracker;
+use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::physics::nonlinear::{NonlinearTld, PowerLaw, state};
@@ -65,6 +65,11 @@ impl Config {
             mass_slosh: slosh,
             mass_inactive: liquid - slosh,
         }
+    }
+
+    /// c = 2 zeta omega_f of Eq 2.11 for the excitation amplitude `amplitude`.
+    fn viscous_coefficient(&self, omega_f: f64, amplitude: f64) -> f64 {
+        2.0 * omega_f * self.damping.zeta(amplitude, self.tank.length, self.lambda)
     }
 
     /// Checks that involve several parameters. Err: the configuration cannot be simulated;
@@ -143,6 +148,10 @@ impl std::fmt::Display for StepError {
     }
 }
 
+/// Length of [`Simulation::snapshot`]: state, carried step, amplitude, mean force (flag and
+/// value), amplitude estimator.
+pub const SNAPSHOT_LEN: usize = state::DIM + 4 + TRACKER_STATE;
+
 #[derive(Clone, Debug, PartialEq)]
 enum Integrator {
     DormandPrince(Dopri5<{ state::DIM }>),
@@ -201,7 +210,7 @@ impl Simulation {
                 )
             }
         };
-        let c = 2.0 * omega_f * config.damping.zeta(amplitude, length, config.lambda);
+        let c = config.viscous_coefficient(omega_f, amplitude);
         let model = NonlinearTld {
             stiffness,
             c,
@@ -243,12 +252,9 @@ impl Simulation {
             amplitude = tr.estimate();
         }
         let mut model = self.model;
-        model.c = 2.0
-            * self.derived.omega_f
-            * self
-                .config
-                .damping
-                .zeta(amplitude, self.config.tank.length, self.config.lambda);
+        model.c = self
+            .config
+            .viscous_coefficient(self.derived.omega_f, amplitude);
         model.base_acceleration = inputs.a;
         let mut y = self.y;
         let mut integrator = self.integrator.clone();
@@ -272,6 +278,61 @@ impl Simulation {
         self.tracker = tracker;
         self.amplitude = amplitude;
         Ok(stats)
+    }
+
+    /// Everything that evolves, as a flat list of numbers (what the configuration does not
+    /// determine). Restore with [`Simulation::restore`] and the same configuration.
+    pub fn snapshot(&self) -> Vec<f64> {
+        let mut out = Vec::with_capacity(SNAPSHOT_LEN);
+        out.extend_from_slice(&self.y);
+        out.push(match &self.integrator {
+            Integrator::DormandPrince(dp) => dp.carried_step(),
+            Integrator::Rk4(_) => 0.0,
+        });
+        out.push(self.amplitude);
+        out.push(f64::from(u8::from(self.last_mean_force.is_some())));
+        out.push(self.last_mean_force.unwrap_or(0.0));
+        out.extend_from_slice(
+            &self
+                .tracker
+                .as_ref()
+                .map_or([0.0; TRACKER_STATE], |t| t.state()),
+        );
+        out
+    }
+
+    /// The simulation `config` describes, in the state `snapshot` recorded.
+    pub fn restore(config: Config, snapshot: &[f64]) -> Result<Self, String> {
+        let (mut sim, _) = Simulation::new(config)?;
+        if snapshot.len() != SNAPSHOT_LEN {
+            return Err(format!(
+                "a state has {SNAPSHOT_LEN} numbers, this one {}",
+                snapshot.len()
+            ));
+        }
+        if snapshot.iter().any(|v| !v.is_finite()) {
+            return Err("the state holds non-finite numbers".into());
+        }
+        let (y, rest) = snapshot.split_at(state::DIM);
+        sim.y.copy_from_slice(y);
+        if let Integrator::DormandPrince(dp) = &mut sim.integrator {
+            dp.set_carried_step(rest[0]);
+        }
+        sim.amplitude = rest[1];
+        sim.last_mean_force = match rest[2] {
+            0.0 => None,
+            1.0 => Some(rest[3]),
+            _ => return Err("the state's mean-force flag is neither 0 nor 1".into()),
+        };
+        if let Some(tracker) = sim.tracker.as_mut() {
+            let mut t = [0.0; TRACKER_STATE];
+            t.copy_from_slice(&rest[4..]);
+            tracker.set_state(&t)?;
+        }
+        sim.model.c = sim
+            .config
+            .viscous_coefficient(sim.derived.omega_f, sim.amplitude);
+        Ok(sim)
     }
 
     pub fn outputs(&self, inputs: &Inputs) -> Outputs {

@@ -543,13 +543,161 @@ not_offered! { "TLD.fmu is a Co-Simulation FMU; Model Exchange is not provided" 
     fn fmi2GetNominalsOfContinuousStates(nominals: *mut fmi2Real, nx: usize);
 }
 
-not_offered! { "canGetAndSetFMUstate and canSerializeFMUstate are false in this version" =>
-    fn fmi2GetFMUstate(state: *mut fmi2FMUstate);
-    fn fmi2SetFMUstate(state: fmi2FMUstate);
-    fn fmi2FreeFMUstate(state: *mut fmi2FMUstate);
-    fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize);
-    fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize);
-    fn fmi2DeSerializeFMUstate(bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate);
+/// What an fmi2FMUstate points to: the instance's state in its serialised form (one code path
+/// for in-memory and serialised states), with a mark to recognise it.
+struct StateBox {
+    magic: u64,
+    bytes: Vec<u8>,
+}
+
+const STATE_MAGIC: u64 = 0x544c_445f_5354_4154;
+
+/// The state behind a host's fmi2FMUstate, if it is one of ours.
+unsafe fn state_box<'a>(state: fmi2FMUstate, function: &str) -> Result<&'a mut StateBox, Refusal> {
+    let p = state as *mut StateBox;
+    // SAFETY: non-null, aligned, and marked: a state this library allocated and did not free.
+    if !p.is_null() && p.is_aligned() && unsafe { (*p).magic } == STATE_MAGIC {
+        Ok(unsafe { &mut *p })
+    } else {
+        Err(refuse(format!(
+            "{function}: the FMU state pointer is null or not a state of this FMU"
+        )))
+    }
+}
+
+fn new_state(bytes: Vec<u8>) -> fmi2FMUstate {
+    Box::into_raw(Box::new(StateBox {
+        magic: STATE_MAGIC,
+        bytes,
+    })) as fmi2FMUstate
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    guard(c, "fmi2GetFMUstate", |inst| {
+        inst.require(allow::ANY, "fmi2GetFMUstate")?;
+        // SAFETY: host output scalar.
+        let out = unsafe { host_ref(FMUstate, "fmi2GetFMUstate: FMUstate")? };
+        let bytes = inst.save();
+        if out.is_null() {
+            *out = new_state(bytes);
+        } else {
+            // The host hands back a state to overwrite.
+            unsafe { state_box(*out, "fmi2GetFMUstate")? }.bytes = bytes;
+        }
+        Ok(Status::Ok)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
+    guard(c, "fmi2SetFMUstate", |inst| {
+        inst.require(allow::ANY, "fmi2SetFMUstate")?;
+        // SAFETY: a host state pointer, recognised by its mark.
+        let state = unsafe { state_box(FMUstate, "fmi2SetFMUstate")? };
+        inst.load(&state.bytes)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2FreeFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    guard(c, "fmi2FreeFMUstate", |inst| {
+        inst.require(allow::ANY, "fmi2FreeFMUstate")?;
+        // SAFETY: host in-out scalar.
+        let slot = unsafe { host_ref(FMUstate, "fmi2FreeFMUstate: FMUstate")? };
+        if slot.is_null() {
+            return Ok(Status::Ok);
+        }
+        // SAFETY: a state of ours: unmark, then take the box back exactly once.
+        let state = unsafe { state_box(*slot, "fmi2FreeFMUstate")? };
+        state.magic = 0;
+        drop(unsafe { Box::from_raw(state as *mut StateBox) });
+        *slot = std::ptr::null_mut();
+        Ok(Status::Ok)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    guard(c, "fmi2SerializedFMUstateSize", |inst| {
+        inst.require(allow::ANY, "fmi2SerializedFMUstateSize")?;
+        // SAFETY: host state and output scalar.
+        let (state, out) = unsafe {
+            (
+                state_box(FMUstate, "fmi2SerializedFMUstateSize")?,
+                host_ref(size, "fmi2SerializedFMUstateSize: size")?,
+            )
+        };
+        *out = state.bytes.len();
+        Ok(Status::Ok)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    serializedState: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    guard(c, "fmi2SerializeFMUstate", |inst| {
+        inst.require(allow::ANY, "fmi2SerializeFMUstate")?;
+        // SAFETY: host state pointer.
+        let state = unsafe { state_box(FMUstate, "fmi2SerializeFMUstate")? };
+        if size != state.bytes.len() {
+            return Err(refuse(format!(
+                "fmi2SerializeFMUstate: size {size} is not the serialised size {} (ask fmi2SerializedFMUstateSize)",
+                state.bytes.len()
+            )));
+        }
+        // SAFETY: host buffer of `size` bytes.
+        let out = unsafe {
+            host_slice_mut(
+                serializedState as *mut u8,
+                size,
+                "fmi2SerializeFMUstate: buffer",
+            )?
+        };
+        out.copy_from_slice(&state.bytes);
+        Ok(Status::Ok)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+    c: fmi2Component,
+    serializedState: *const fmi2Byte,
+    size: usize,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    guard(c, "fmi2DeSerializeFMUstate", |inst| {
+        inst.require(allow::ANY, "fmi2DeSerializeFMUstate")?;
+        // SAFETY: host buffer of `size` bytes and host output scalar.
+        let (bytes, out) = unsafe {
+            (
+                host_slice(
+                    serializedState as *const u8,
+                    size,
+                    "fmi2DeSerializeFMUstate: buffer",
+                )?,
+                host_ref(FMUstate, "fmi2DeSerializeFMUstate: FMUstate")?,
+            )
+        };
+        Instance::check_saved(bytes)
+            .map_err(|r| refuse(format!("fmi2DeSerializeFMUstate: {}", r.message)))?;
+        *out = new_state(bytes.to_vec());
+        Ok(Status::Ok)
+    })
 }
 
 not_offered! { "providesDirectionalDerivative is false" =>

@@ -5,6 +5,7 @@ use std::ffi::CString;
 
 use super::logger::Logger;
 use super::params::{Values, calculated};
+use super::snapshot::Saved;
 use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, index_of, vr};
 use crate::simulation::{Derived, Outputs, Simulation, StepError};
 use crate::solver::SolveError;
@@ -477,6 +478,87 @@ impl Instance {
                 })
             }
         }
+    }
+
+    /// The whole instance (less what the host gave it) as bytes.
+    pub fn save(&self) -> Vec<u8> {
+        Saved {
+            phase: match self.phase {
+                Phase::Instantiated => 0,
+                Phase::InitializationMode => 1,
+                Phase::StepComplete => 2,
+                Phase::Terminated | Phase::Broken => 3,
+            },
+            user_tolerance: self.user_tolerance,
+            tolerance: self.experiment.tolerance,
+            start: self.experiment.start,
+            stop: self.experiment.stop,
+            time: self.time,
+            values: self.values.as_slice().to_vec(),
+            simulation: self
+                .sim
+                .as_ref()
+                .map(Simulation::snapshot)
+                .unwrap_or_default(),
+        }
+        .encode()
+    }
+
+    /// Check a saved state completely, without applying it.
+    pub fn check_saved(bytes: &[u8]) -> Result<(), Refusal> {
+        Self::restored(bytes).map(|_| ())
+    }
+
+    /// Become the instance `bytes` describes; on any error nothing changes.
+    pub fn load(&mut self, bytes: &[u8]) -> Reply {
+        let (phase, values, experiment, user_tolerance, time, sim) = Self::restored(bytes)?;
+        self.phase = phase;
+        self.values = values;
+        self.experiment = experiment;
+        self.user_tolerance = user_tolerance;
+        self.time = time;
+        self.sim = sim;
+        Ok(Status::Ok)
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn restored(
+        bytes: &[u8],
+    ) -> Result<(Phase, Values, Experiment, bool, f64, Option<Simulation>), Refusal> {
+        let bad = |why: String| refuse(format!("the FMU state is not usable: {why}"));
+        let s = Saved::decode(bytes).map_err(|r| bad(r.message))?;
+        let phase = match s.phase {
+            0 => Phase::Instantiated,
+            1 => Phase::InitializationMode,
+            2 => Phase::StepComplete,
+            3 => Phase::Terminated,
+            other => return Err(bad(format!("unknown state code {other}"))),
+        };
+        let finite = [s.time, s.start, s.stop.unwrap_or(0.0)]
+            .iter()
+            .all(|x| x.is_finite());
+        let tolerance_ok = s.tolerance.is_none_or(|t| t.is_finite() && t > 0.0);
+        if !finite || !tolerance_ok {
+            return Err(bad("non-finite time, tolerance or experiment bounds".into()));
+        }
+        let values = Values::from_saved(&s.values).map_err(bad)?;
+        let initialised = matches!(phase, Phase::StepComplete | Phase::Terminated);
+        let sim = if initialised {
+            let config = values.config(s.tolerance, s.user_tolerance);
+            Some(Simulation::restore(config, &s.simulation).map_err(bad)?)
+        } else if s.simulation.is_empty() {
+            None
+        } else {
+            return Err(bad(
+                "simulation values in a state before initialisation".into()
+            ));
+        };
+        let experiment = Experiment {
+            tolerance: s.tolerance,
+            start: s.start,
+            stop: s.stop,
+        };
+        Ok((phase, values, experiment, s.user_tolerance, s.time, sim))
     }
 
     pub fn last_successful_time(&self) -> Result<f64, Refusal> {

@@ -5,6 +5,7 @@ mod exports;
 mod instance;
 mod logger;
 mod params;
+mod snapshot;
 pub mod vars;
 
 pub use instance::Status;

@@ -21,6 +21,32 @@ impl Values {
         )
     }
 
+    /// Values checked one by one against the model description (finite, in range, an
+    /// enumeration item); calculated variables carry no value and are ignored.
+    pub fn from_saved(saved: &[f64]) -> Result<Self, String> {
+        if saved.len() != VARIABLES.len() {
+            return Err(format!(
+                "{} values for {} variables",
+                saved.len(),
+                VARIABLES.len()
+            ));
+        }
+        let mut values = Values::start();
+        for ((slot, var), &value) in values.0.iter_mut().zip(VARIABLES).zip(saved) {
+            if var.start.is_some() {
+                if let Some(reason) = var.reject(value) {
+                    return Err(reason);
+                }
+                *slot = value;
+            }
+        }
+        Ok(values)
+    }
+
+    pub fn as_slice(&self) -> &[f64] {
+        &self.0
+    }
+
     pub fn get(&self, vr: u32) -> f64 {
         index_of(vr)
             .and_then(|i| self.0.get(i))

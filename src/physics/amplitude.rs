@@ -22,6 +22,9 @@ impl MeanSquare {
     }
 }
 
+/// Number of values in [`AmplitudeTracker::state`].
+pub const TRACKER_STATE: usize = 8;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct AmplitudeTracker {
     tau: f64,
@@ -71,6 +74,45 @@ impl AmplitudeTracker {
         // Exact advance of v' = a - w_c v with a held.
         let decay = (-self.leak * h).exp();
         self.rebuilt_v = self.rebuilt_v * decay - accel * (-self.leak * h).exp_m1() / self.leak;
+    }
+
+    /// The evolving part of the estimator, for saving the state.
+    pub fn state(&self) -> [f64; TRACKER_STATE] {
+        [
+            self.rebuilt_v,
+            f64::from(u8::from(self.measured_v_seen)),
+            self.ms_v.first,
+            self.ms_v.second,
+            self.ms_a.first,
+            self.ms_a.second,
+            self.weight.first,
+            self.weight.second,
+        ]
+    }
+
+    /// Restore a state saved with [`AmplitudeTracker::state`].
+    pub fn set_state(&mut self, s: &[f64; TRACKER_STATE]) -> Result<(), String> {
+        if s.iter().any(|v| !v.is_finite())
+            || s[2..].iter().any(|v| *v < 0.0)
+            || !matches!(s[1], 0.0 | 1.0)
+        {
+            return Err("amplitude estimator state out of range".into());
+        }
+        self.rebuilt_v = s[0];
+        self.measured_v_seen = s[1] == 1.0;
+        self.ms_v = MeanSquare {
+            first: s[2],
+            second: s[3],
+        };
+        self.ms_a = MeanSquare {
+            first: s[4],
+            second: s[5],
+        };
+        self.weight = MeanSquare {
+            first: s[6],
+            second: s[7],
+        };
+        Ok(())
     }
 
     /// The current amplitude estimate [m].

@@ -64,9 +64,14 @@ impl<const N: usize> Dopri5<N> {
         }
     }
 
-    /// Forget the carried step size (after a jump in the state).
-    pub fn reset(&mut self) {
-        self.h_next = 0.0;
+    /// The step size carried into the next interval (0: none yet), for saving the state.
+    pub fn carried_step(&self) -> f64 {
+        self.h_next
+    }
+
+    /// Restore a carried step size saved with [`Dopri5::carried_step`].
+    pub fn set_carried_step(&mut self, h: f64) {
+        self.h_next = if h.is_finite() && h > 0.0 { h } else { 0.0 };
     }
 
     fn norm(&self, e: &[f64; N], y0: &[f64; N], y1: &[f64; N]) -> f64 {
