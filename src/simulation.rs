@@ -4,7 +4,7 @@
 use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
-use crate::physics::nonlinear::{NonlinearTld, PowerLaw, state};
+use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, state};
 use crate::solver::{Dopri5, Rk4, SolveError, SolveStats};
 
 /// Where the excitation amplitude of the amplitude laws comes from.
@@ -111,6 +111,8 @@ pub struct Inputs {
     pub a: f64,
     pub v: f64,
     pub x: f64,
+    /// First and second time derivatives of `a` at the step's start (0: held).
+    pub a_derivatives: [f64; 2],
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -214,7 +216,7 @@ impl Simulation {
         let model = NonlinearTld {
             stiffness,
             c,
-            base_acceleration: 0.0,
+            base: BaseAcceleration::held(0.0),
         };
         let mut y = [0.0; state::DIM];
         y[state::X] = config.x0;
@@ -242,8 +244,9 @@ impl Simulation {
         self.derived
     }
 
-    /// Advance by `h` > 0 from time `t` with the inputs held. All or nothing: on error the
-    /// simulation is unchanged.
+    /// Advance by `h` > 0 from time `t`, the base acceleration following its Taylor polynomial
+    /// from `inputs` (held when the derivatives are 0). All or nothing: on error the simulation
+    /// is unchanged.
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<SolveStats, StepError> {
         let mut tracker = self.tracker.clone();
         let mut amplitude = self.amplitude;
@@ -255,7 +258,11 @@ impl Simulation {
         model.c = self
             .config
             .viscous_coefficient(self.derived.omega_f, amplitude);
-        model.base_acceleration = inputs.a;
+        let [a1, a2] = inputs.a_derivatives;
+        model.base = BaseAcceleration {
+            t0: t,
+            a: [inputs.a, a1, a2],
+        };
         let mut y = self.y;
         let mut integrator = self.integrator.clone();
         let stats = match &mut integrator {
@@ -333,6 +340,27 @@ impl Simulation {
             .config
             .viscous_coefficient(sim.derived.omega_f, sim.amplitude);
         Ok(sim)
+    }
+
+    /// Exact first time derivatives of the outputs now (quantities that are constant between
+    /// communication points have derivative 0).
+    pub fn output_derivatives(&self, inputs: &Inputs) -> Outputs {
+        let m = self.derived.mass_slosh;
+        let (x, v) = (self.y[state::X], self.y[state::V]);
+        let acc = self.model.acceleration(x, v, inputs.a);
+        let force = m * (self.model.c * acc + self.model.stiffness.slope(x) * v);
+        Outputs {
+            force,
+            force_mean: 0.0,
+            base_shear: force - self.derived.mass_inactive * inputs.a_derivatives[0],
+            x: v,
+            v: acc,
+            energy_input: -m * inputs.a * v,
+            energy_dissipated: m * self.model.c * v * v,
+            energy_stored: m * v * (acc + self.model.stiffness.force(x)),
+            amplitude: 0.0,
+            zeta: 0.0,
+        }
     }
 
     pub fn outputs(&self, inputs: &Inputs) -> Outputs {
@@ -485,6 +513,7 @@ mod tests {
                         a: -w * w * amp * (w * t).sin(),
                         v,
                         x: amp * (w * t).sin(),
+                        ..Inputs::default()
                     };
                     sim.step(t, h, &inputs).expect("step");
                     if k > 4000 {

@@ -695,7 +695,13 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
         };
         Instance::check_saved(bytes)
             .map_err(|r| refuse(format!("fmi2DeSerializeFMUstate: {}", r.message)))?;
-        *out = new_state(bytes.to_vec());
+        // A host may hand back one of our states for reuse (fmpy does); anything else in the
+        // slot is not ours to free, and a new state is made.
+        // SAFETY: a host state pointer, recognised by its mark.
+        match unsafe { state_box(*out, "fmi2DeSerializeFMUstate") } {
+            Ok(state) => state.bytes = bytes.to_vec(),
+            Err(_) => *out = new_state(bytes.to_vec()),
+        }
         Ok(Status::Ok)
     })
 }
@@ -704,9 +710,48 @@ not_offered! { "providesDirectionalDerivative is false" =>
     fn fmi2GetDirectionalDerivative(unknowns: *const fmi2ValueReference, n_unknown: usize, knowns: *const fmi2ValueReference, n_known: usize, dv_known: *const fmi2Real, dv_unknown: *mut fmi2Real);
 }
 
-not_offered! { "canInterpolateInputs is false and maxOutputDerivativeOrder is 0 in this version" =>
-    fn fmi2SetRealInputDerivatives(vr: *const fmi2ValueReference, nvr: usize, order: *const fmi2Integer, value: *const fmi2Real);
-    fn fmi2GetRealOutputDerivatives(vr: *const fmi2ValueReference, nvr: usize, order: *const fmi2Integer, value: *mut fmi2Real);
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    order: *const fmi2Integer,
+    value: *const fmi2Real,
+) -> fmi2Status {
+    const F: &str = "fmi2SetRealInputDerivatives";
+    guard(c, F, |inst| {
+        // SAFETY: host arrays of nvr elements.
+        let (vrs, orders, values) = unsafe {
+            (
+                host_slice(vr, nvr, "vr")?,
+                host_slice(order, nvr, "order")?,
+                host_slice(value, nvr, "value")?,
+            )
+        };
+        inst.set_input_derivatives(vrs, orders, values)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    order: *const fmi2Integer,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    const F: &str = "fmi2GetRealOutputDerivatives";
+    guard(c, F, |inst| {
+        // SAFETY: host arrays of nvr elements.
+        let (vrs, orders, out) = unsafe {
+            (
+                host_slice(vr, nvr, "vr")?,
+                host_slice(order, nvr, "order")?,
+                host_slice_mut(value, nvr, "value")?,
+            )
+        };
+        inst.output_derivatives(vrs, orders, |k, v| out[k] = v)
+    })
 }
 
 // The signatures above must match the FMI 2.0 headers exactly (checked at compile time against

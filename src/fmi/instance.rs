@@ -103,6 +103,17 @@ struct Experiment {
 
 const MAGIC: u64 = 0x544c_445f_464d_5532;
 
+/// A saved state, checked and ready to become the instance.
+struct Restored {
+    phase: Phase,
+    values: Values,
+    experiment: Experiment,
+    user_tolerance: bool,
+    time: f64,
+    a_derivatives: [f64; 2],
+    sim: Option<Simulation>,
+}
+
 pub struct Instance {
     magic: u64,
     name: CString,
@@ -114,6 +125,8 @@ pub struct Instance {
     user_tolerance: bool,
     experiment: Experiment,
     time: f64,
+    /// Derivatives of base.a (orders 1 and 2) for the next step only.
+    a_derivatives: [f64; 2],
     sim: Option<Simulation>,
 }
 
@@ -130,6 +143,7 @@ impl Instance {
             user_tolerance: false,
             experiment: Experiment::default(),
             time: 0.0,
+            a_derivatives: [0.0; 2],
             sim: None,
         }
     }
@@ -306,6 +320,7 @@ impl Instance {
         self.user_tolerance = false;
         self.experiment = Experiment::default();
         self.time = 0.0;
+        self.a_derivatives = [0.0; 2];
         self.sim = None;
         Ok(Status::Ok)
     }
@@ -320,7 +335,7 @@ impl Instance {
     /// Calculated parameters and outputs now: from the running simulation, or during
     /// initialisation from one built on the parameters set so far.
     fn current(&self) -> Result<(Derived, Outputs), Refusal> {
-        let inputs = self.values.inputs();
+        let inputs = self.values.inputs(self.a_derivatives);
         match &self.sim {
             Some(sim) => Ok((sim.derived(), sim.outputs(&inputs))),
             None => {
@@ -424,6 +439,69 @@ impl Instance {
         Ok(())
     }
 
+    /// fmi2SetRealInputDerivatives: derivatives of Real inputs for the next step. base.a's are
+    /// used (orders 1 and 2); those of base.v and base.x are accepted and not needed.
+    pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Reply {
+        const F: &str = "fmi2SetRealInputDerivatives";
+        self.require(allow::SET, F)?;
+        for ((&r, &order), &value) in vrs.iter().zip(orders).zip(values) {
+            let (_, var) = Self::variable(r, F)?;
+            if var.causality != Causality::Input || var.ty != VarType::Real {
+                return Err(refuse(format!("{F}: '{}' is not a Real input", var.name)));
+            }
+            if !(1..=2).contains(&order) {
+                return Err(refuse(format!(
+                    "{F}: order {order} for '{}' is not supported (1 or 2)",
+                    var.name
+                )));
+            }
+            if !value.is_finite() {
+                return Err(refuse(format!(
+                    "{F}: derivative {value} of '{}' must be finite",
+                    var.name
+                )));
+            }
+        }
+        for ((&r, &order), &value) in vrs.iter().zip(orders).zip(values) {
+            if r == vr::BASE_A {
+                self.a_derivatives[order as usize - 1] = value;
+            }
+        }
+        Ok(Status::Ok)
+    }
+
+    /// fmi2GetRealOutputDerivatives: exact first derivatives of outputs, handed to `put`.
+    pub fn output_derivatives(
+        &self,
+        vrs: &[u32],
+        orders: &[i32],
+        mut put: impl FnMut(usize, f64),
+    ) -> Reply {
+        const F: &str = "fmi2GetRealOutputDerivatives";
+        self.require(allow::STATUS, F)?;
+        let sim = self
+            .sim
+            .as_ref()
+            .ok_or_else(|| refuse(format!("{F}: not initialised")))?;
+        let derivatives = sim.output_derivatives(&self.values.inputs(self.a_derivatives));
+        for (k, (&r, &order)) in vrs.iter().zip(orders).enumerate() {
+            let (_, var) = Self::variable(r, F)?;
+            if var.causality != Causality::Output {
+                return Err(refuse(format!("{F}: '{}' is not an output", var.name)));
+            }
+            if order != 1 {
+                return Err(refuse(format!(
+                    "{F}: order {order} of '{}' is not offered (maxOutputDerivativeOrder = 1)",
+                    var.name
+                )));
+            }
+            let value = calculated(r, &sim.derived(), &derivatives)
+                .ok_or_else(|| refuse(format!("{F}: '{}' has no derivative", var.name)))?;
+            put(k, value);
+        }
+        Ok(Status::Ok)
+    }
+
     pub fn do_step(&mut self, t: f64, h: f64) -> Reply {
         self.require(allow::STEP_COMPLETE, "fmi2DoStep")?;
         if !(h.is_finite() && h > 0.0) {
@@ -452,7 +530,7 @@ impl Instance {
                 t + h
             )));
         }
-        let inputs = self.values.inputs();
+        let inputs = self.values.inputs(self.a_derivatives);
         let sim = self
             .sim
             .as_mut()
@@ -460,6 +538,8 @@ impl Instance {
         match sim.step(t, h, &inputs) {
             Ok(_) => {
                 self.time = t + h;
+                // Input derivatives describe one communication step.
+                self.a_derivatives = [0.0; 2];
                 Ok(Status::Ok)
             }
             Err(e) => {
@@ -494,6 +574,7 @@ impl Instance {
             start: self.experiment.start,
             stop: self.experiment.stop,
             time: self.time,
+            a_derivatives: self.a_derivatives,
             values: self.values.as_slice().to_vec(),
             simulation: self
                 .sim
@@ -511,20 +592,18 @@ impl Instance {
 
     /// Become the instance `bytes` describes; on any error nothing changes.
     pub fn load(&mut self, bytes: &[u8]) -> Reply {
-        let (phase, values, experiment, user_tolerance, time, sim) = Self::restored(bytes)?;
-        self.phase = phase;
-        self.values = values;
-        self.experiment = experiment;
-        self.user_tolerance = user_tolerance;
-        self.time = time;
-        self.sim = sim;
+        let r = Self::restored(bytes)?;
+        self.phase = r.phase;
+        self.values = r.values;
+        self.experiment = r.experiment;
+        self.user_tolerance = r.user_tolerance;
+        self.time = r.time;
+        self.a_derivatives = r.a_derivatives;
+        self.sim = r.sim;
         Ok(Status::Ok)
     }
 
-    #[allow(clippy::type_complexity)]
-    fn restored(
-        bytes: &[u8],
-    ) -> Result<(Phase, Values, Experiment, bool, f64, Option<Simulation>), Refusal> {
+    fn restored(bytes: &[u8]) -> Result<Restored, Refusal> {
         let bad = |why: String| refuse(format!("the FMU state is not usable: {why}"));
         let s = Saved::decode(bytes).map_err(|r| bad(r.message))?;
         let phase = match s.phase {
@@ -534,12 +613,15 @@ impl Instance {
             3 => Phase::Terminated,
             other => return Err(bad(format!("unknown state code {other}"))),
         };
-        let finite = [s.time, s.start, s.stop.unwrap_or(0.0)]
+        let [d1, d2] = s.a_derivatives;
+        let finite = [s.time, s.start, s.stop.unwrap_or(0.0), d1, d2]
             .iter()
             .all(|x| x.is_finite());
         let tolerance_ok = s.tolerance.is_none_or(|t| t.is_finite() && t > 0.0);
         if !finite || !tolerance_ok {
-            return Err(bad("non-finite time, tolerance or experiment bounds".into()));
+            return Err(bad(
+                "non-finite time, tolerance, experiment bounds or input derivatives".into(),
+            ));
         }
         let values = Values::from_saved(&s.values).map_err(bad)?;
         let initialised = matches!(phase, Phase::StepComplete | Phase::Terminated);
@@ -553,12 +635,19 @@ impl Instance {
                 "simulation values in a state before initialisation".into()
             ));
         };
-        let experiment = Experiment {
-            tolerance: s.tolerance,
-            start: s.start,
-            stop: s.stop,
-        };
-        Ok((phase, values, experiment, s.user_tolerance, s.time, sim))
+        Ok(Restored {
+            phase,
+            values,
+            experiment: Experiment {
+                tolerance: s.tolerance,
+                start: s.start,
+                stop: s.stop,
+            },
+            user_tolerance: s.user_tolerance,
+            time: s.time,
+            a_derivatives: s.a_derivatives,
+            sim,
+        })
     }
 
     pub fn last_successful_time(&self) -> Result<f64, Refusal> {

@@ -64,11 +64,13 @@ impl Values {
         }
     }
 
-    pub fn inputs(&self) -> Inputs {
+    /// The inputs, with the derivatives of base.a the host set for the coming step.
+    pub fn inputs(&self, a_derivatives: [f64; 2]) -> Inputs {
         Inputs {
             a: self.get(vr::BASE_A),
             v: self.get(vr::BASE_V),
             x: self.get(vr::BASE_X),
+            a_derivatives,
         }
     }
 

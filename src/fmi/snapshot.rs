@@ -6,6 +6,7 @@
 //! "TLDs" | format version u16 | reserved u16 | GUID length u16 | GUID bytes
 //!        | payload length u32 | payload | FNV-1a 64 checksum of everything before it
 //! payload: phase u8 | flags u8 | time, tolerance, start, stop f64
+//!        | derivatives of base.a for the next step (orders 1, 2) f64
 //!        | number of variables u32 | their values f64...
 //!        | number of simulation values u32 (0: not initialised) | the values f64...
 //! ```
@@ -26,6 +27,7 @@ pub struct Saved {
     pub start: f64,
     pub stop: Option<f64>,
     pub time: f64,
+    pub a_derivatives: [f64; 2],
     pub values: Vec<f64>,
     pub simulation: Vec<f64>,
 }
@@ -44,11 +46,14 @@ impl Saved {
             | u8::from(self.tolerance.is_some()) << 1
             | u8::from(self.stop.is_some()) << 2;
         p.push(flags);
+        let [d1, d2] = self.a_derivatives;
         for x in [
             self.time,
             self.tolerance.unwrap_or(0.0),
             self.start,
             self.stop.unwrap_or(0.0),
+            d1,
+            d2,
         ] {
             p.extend_from_slice(&x.to_le_bytes());
         }
@@ -113,6 +118,7 @@ impl Saved {
         let phase = p.u8()?;
         let flags = p.u8()?;
         let (time, tolerance, start, stop) = (p.f64()?, p.f64()?, p.f64()?, p.f64()?);
+        let a_derivatives = [p.f64()?, p.f64()?];
         let values = p.f64_list()?;
         let simulation = p.f64_list()?;
         if p.at != payload_len {
@@ -125,6 +131,7 @@ impl Saved {
             start,
             stop: (flags & 4 != 0).then_some(stop),
             time,
+            a_derivatives,
             values,
             simulation,
         })

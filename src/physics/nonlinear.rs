@@ -66,6 +66,11 @@ impl PowerLaw {
         self.omega2 * x * (1.0 + self.hardening(x))
     }
 
+    /// dPhi/dx = omega_f^2 [1 + (2 eta - 1) phi |xi|^(2eta-2)]: the local stiffness.
+    pub fn slope(&self, x: f64) -> f64 {
+        self.omega2 * (1.0 + (2.0 * self.eta - 1.0) * self.hardening(x))
+    }
+
     /// U(x) = integral of Phi from 0 to x = omega_f^2 x^2/2 [1 + phi |xi|^(2eta-2) / eta].
     pub fn potential(&self, x: f64) -> f64 {
         0.5 * self.omega2 * x * x * (1.0 + self.hardening(x) / self.eta)
@@ -87,14 +92,36 @@ pub mod state {
     pub const DIM: usize = 5;
 }
 
-/// Eq 2.11 driven by a base acceleration held over the interval being integrated.
+/// Base (tank) acceleration over one communication step: a Taylor polynomial about the step's
+/// start t0, a(t) = a0 + a1 (t - t0) + a2 (t - t0)^2 / 2. Held input: a1 = a2 = 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BaseAcceleration {
+    pub t0: f64,
+    pub a: [f64; 3],
+}
+
+impl BaseAcceleration {
+    pub fn held(a0: f64) -> Self {
+        BaseAcceleration {
+            t0: 0.0,
+            a: [a0, 0.0, 0.0],
+        }
+    }
+
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        let s = t - self.t0;
+        self.a[0] + s * (self.a[1] + 0.5 * s * self.a[2])
+    }
+}
+
+/// Eq 2.11 driven by a base acceleration given over the interval being integrated.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NonlinearTld {
     pub stiffness: PowerLaw,
     /// Viscous coefficient c = 2 zeta omega_f.
     pub c: f64,
-    /// Base (tank) acceleration a_b.
-    pub base_acceleration: f64,
+    pub base: BaseAcceleration,
 }
 
 impl NonlinearTld {
@@ -108,16 +135,23 @@ impl NonlinearTld {
     pub fn stored_energy(&self, x: f64, v: f64) -> f64 {
         0.5 * v * v + self.stiffness.potential(x)
     }
+
+    /// Relative acceleration x'' at (x, v) under base acceleration `a_b`.
+    #[inline]
+    pub fn acceleration(&self, x: f64, v: f64, a_b: f64) -> f64 {
+        -a_b - self.tank_force(x, v)
+    }
 }
 
 impl Rhs<{ state::DIM }> for NonlinearTld {
     #[inline]
-    fn eval(&self, _t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
+    fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
         let (x, v) = (y[state::X], y[state::V]);
         let f = self.tank_force(x, v);
+        let a_b = self.base.at(t);
         dy[state::X] = v;
-        dy[state::V] = -self.base_acceleration - f;
-        dy[state::WORK_IN] = -self.base_acceleration * v;
+        dy[state::V] = -a_b - f;
+        dy[state::WORK_IN] = -a_b * v;
         dy[state::DISSIPATED] = self.c * v * v;
         dy[state::IMPULSE] = f;
     }
@@ -163,6 +197,22 @@ mod tests {
                 );
             }
             assert_eq!(law.potential(0.0), 0.0);
+        }
+    }
+
+    #[test]
+    fn slope_is_the_derivative_of_phi() {
+        for eta in [1.0, 2.0, 3.5, 10.0] {
+            let law = PowerLaw::new(4.0, 0.7, eta, 0.5);
+            for x in [-0.3, -0.1, 0.02, 0.2, 0.26] {
+                let d = 1e-6;
+                let fd = (law.force(x + d) - law.force(x - d)) / (2.0 * d);
+                assert!(
+                    (fd - law.slope(x)).abs() < 1e-6 * law.slope(x),
+                    "eta {eta} x {x}: {fd} {}",
+                    law.slope(x)
+                );
+            }
         }
     }
 
