@@ -57,19 +57,30 @@ fn variable_table() -> String {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() != 3 {
-        eprintln!("usage: tld-package <libtld_fmu.so> <TLD.fmu>");
+    if args.len() < 3 {
+        eprintln!("usage: tld-package <TLD.fmu> <library> [<library> ...]");
+        eprintln!("  each library's file name says its platform: *.so -> binaries/linux64/TLD.so,");
+        eprintln!("  *.dll -> binaries/win64/TLD.dll, *.dylib -> binaries/darwin64/TLD.dylib");
         std::process::exit(2);
     }
-    if let Err(e) = pack(Path::new(&args[1]), Path::new(&args[2])) {
+    let libraries: Vec<&Path> = args[2..].iter().map(Path::new).collect();
+    if let Err(e) = pack(Path::new(&args[1]), &libraries) {
         eprintln!("tld-package: {e}");
         std::process::exit(1);
     }
 }
 
-fn pack(library: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
-    let binary =
-        std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+/// Where a built library goes in the FMU (FMI 2.0 section 2.3), from its file name.
+fn platform_path(library: &Path) -> Result<&'static str, String> {
+    match library.extension().and_then(|e| e.to_str()) {
+        Some("so") => Ok("binaries/linux64/TLD.so"),
+        Some("dll") => Ok("binaries/win64/TLD.dll"),
+        Some("dylib") => Ok("binaries/darwin64/TLD.dylib"),
+        _ => Err(format!("{}: not a .so, .dll or .dylib", library.display())),
+    }
+}
+
+fn pack(out: &Path, libraries: &[&Path]) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir)?;
     }
@@ -80,14 +91,26 @@ fn pack(library: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     zip.start_file("modelDescription.xml", options)?;
     zip.write_all(XML.as_bytes())?;
-    zip.add_directory("binaries/", options)?;
-    zip.add_directory("binaries/linux64/", options)?;
-    zip.start_file("binaries/linux64/TLD.so", options.unix_permissions(0o755))?;
-    zip.write_all(&binary)?;
-    zip.add_directory("documentation/", options)?;
+    let mut placed: Vec<&str> = Vec::new();
+    for library in libraries {
+        let inside = platform_path(library)?;
+        if placed.contains(&inside) {
+            return Err(format!("two libraries for {inside}").into());
+        }
+        let binary = std::fs::read(library)
+            .map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+        zip.start_file(inside, options.unix_permissions(0o755))?;
+        zip.write_all(&binary)?;
+        println!(
+            "  {inside}: {} bytes from {}",
+            binary.len(),
+            library.display()
+        );
+        placed.push(inside);
+    }
     zip.start_file("documentation/index.html", options)?;
     zip.write_all(doc.as_bytes())?;
     zip.finish()?;
-    println!("wrote {} ({} bytes of binary)", out.display(), binary.len());
+    println!("wrote {}", out.display());
     Ok(())
 }
