@@ -115,7 +115,7 @@ def test_one_hour_random_run_matches_the_exact_stationary_statistics(slave_facto
     p = R.TLD(eta=3.0, phi=1.0, damping=R.DAMPING_CONSTANT, zeta=0.05)
     dt, n = 0.01, 360_000
     rng = np.random.default_rng(20261122)
-    sigma_a = 2.0                              # m/s^2 per held sample
+    sigma_a = 5.0                              # m/s^2 per held sample: 2 sigma_x / a = 0.53
     a = sigma_a * rng.standard_normal(n)
     D = sigma_a ** 2 * dt                      # intensity of the equivalent white noise
     out = fmu_run(slave_factory, p, dt, n, {"base.a": a})
@@ -140,4 +140,4 @@ def test_one_hour_random_run_matches_the_exact_stationary_statistics(slave_facto
     assert var_v == pytest.approx(var_v_exact, rel=0.12)
     assert var_x == pytest.approx(var_x_exact, rel=0.12)
     var_x_linear = D / (2 * c * p.omega_f ** 2)
-    assert abs(var_x_linear / var_x_exact - 1) > 0.3, "the scene must be clearly nonlinear"
+    assert var_x_linear / var_x_exact > 1.5, "the scene must be clearly nonlinear (linear: 1.6 x)"
