@@ -5,7 +5,7 @@ use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, state};
-use crate::solver::{Dopri5, Rk4, SolveError, SolveStats};
+use crate::solver::{Auto, Dopri5, Rk4, Sdirk4, SolveError, SolveStats};
 
 /// Where the excitation amplitude of the amplitude laws comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,10 +20,25 @@ pub enum AmplitudeSource {
 /// Integrator inside a communication step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Method {
-    /// Dormand-Prince 5(4) with relative tolerance `rtol`, internal steps <= `max_step` (0: none).
-    DormandPrince { rtol: f64, max_step: f64 },
+    /// An error-controlled method at relative tolerance `rtol`, internal steps <= `max_step`
+    /// (0: no bound beyond the communication step).
+    Adaptive {
+        kind: AdaptiveKind,
+        rtol: f64,
+        max_step: f64,
+    },
     /// Classical RK4 with internal steps <= `step`.
     Rk4 { step: f64 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AdaptiveKind {
+    /// Explicit Dormand-Prince 5(4).
+    DormandPrince,
+    /// L-stable implicit SDIRK4.
+    Sdirk4,
+    /// Per interval, whichever of the two the local stiffness calls for.
+    Auto,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -150,14 +165,52 @@ impl std::fmt::Display for StepError {
     }
 }
 
-/// Length of [`Simulation::snapshot`]: state, carried step, amplitude, mean force (flag and
-/// value), amplitude estimator.
-pub const SNAPSHOT_LEN: usize = state::DIM + 4 + TRACKER_STATE;
+/// Length of [`Simulation::snapshot`]: state, two carried steps, amplitude, mean force (flag
+/// and value), amplitude estimator.
+pub const SNAPSHOT_LEN: usize = state::DIM + 5 + TRACKER_STATE;
 
 #[derive(Clone, Debug, PartialEq)]
 enum Integrator {
     DormandPrince(Dopri5<{ state::DIM }>),
+    Sdirk4(Sdirk4<{ state::DIM }>),
+    Auto(Auto<{ state::DIM }>),
     Rk4(Rk4),
+}
+
+impl Integrator {
+    fn integrate(
+        &mut self,
+        model: &NonlinearTld,
+        t0: f64,
+        t1: f64,
+        y: &mut [f64; state::DIM],
+    ) -> Result<SolveStats, SolveError> {
+        match self {
+            Integrator::DormandPrince(m) => m.integrate(model, t0, t1, y),
+            Integrator::Sdirk4(m) => m.integrate(model, t0, t1, y),
+            Integrator::Auto(m) => m.integrate(model, t0, t1, y),
+            Integrator::Rk4(m) => m.integrate(model, t0, t1, y),
+        }
+    }
+
+    /// Step sizes carried between intervals (what the configuration does not determine).
+    fn carried_steps(&self) -> [f64; 2] {
+        match self {
+            Integrator::DormandPrince(m) => [m.carried_step(), 0.0],
+            Integrator::Sdirk4(m) => [m.carried_step(), 0.0],
+            Integrator::Auto(m) => m.carried_steps(),
+            Integrator::Rk4(_) => [0.0; 2],
+        }
+    }
+
+    fn set_carried_steps(&mut self, h: [f64; 2]) {
+        match self {
+            Integrator::DormandPrince(m) => m.set_carried_step(h[0]),
+            Integrator::Sdirk4(m) => m.set_carried_step(h[0]),
+            Integrator::Auto(m) => m.set_carried_steps(h),
+            Integrator::Rk4(_) => {}
+        }
+    }
 }
 
 /// A configured damper and its state.
@@ -184,7 +237,11 @@ impl Simulation {
         let stiffness = PowerLaw::new(omega_f, config.phi, config.eta, length);
         let half = 0.5 * length;
         let integrator = match config.method {
-            Method::DormandPrince { rtol, max_step } => {
+            Method::Adaptive {
+                kind,
+                rtol,
+                max_step,
+            } => {
                 let mut scale = [0.0; state::DIM];
                 scale[state::X] = half;
                 scale[state::V] = omega_f * half;
@@ -193,7 +250,16 @@ impl Simulation {
                 } else {
                     f64::INFINITY
                 };
-                Integrator::DormandPrince(Dopri5::new(rtol, scale, max_step, config.max_substeps))
+                let n = config.max_substeps;
+                match kind {
+                    AdaptiveKind::DormandPrince => {
+                        Integrator::DormandPrince(Dopri5::new(rtol, scale, max_step, n))
+                    }
+                    AdaptiveKind::Sdirk4 => {
+                        Integrator::Sdirk4(Sdirk4::new(rtol, scale, max_step, n))
+                    }
+                    AdaptiveKind::Auto => Integrator::Auto(Auto::new(rtol, scale, max_step, n)),
+                }
             }
             Method::Rk4 { step } => Integrator::Rk4(Rk4 {
                 max_step: step,
@@ -265,11 +331,9 @@ impl Simulation {
         };
         let mut y = self.y;
         let mut integrator = self.integrator.clone();
-        let stats = match &mut integrator {
-            Integrator::DormandPrince(dp) => dp.integrate(&model, t, t + h, &mut y),
-            Integrator::Rk4(rk) => rk.integrate(&model, t, t + h, &mut y),
-        }
-        .map_err(StepError::Solver)?;
+        let stats = integrator
+            .integrate(&model, t, t + h, &mut y)
+            .map_err(StepError::Solver)?;
         let limit = 100.0 * self.config.tank.length;
         if y[state::X].abs() > limit {
             return Err(StepError::Runaway {
@@ -292,10 +356,7 @@ impl Simulation {
     pub fn snapshot(&self) -> Vec<f64> {
         let mut out = Vec::with_capacity(SNAPSHOT_LEN);
         out.extend_from_slice(&self.y);
-        out.push(match &self.integrator {
-            Integrator::DormandPrince(dp) => dp.carried_step(),
-            Integrator::Rk4(_) => 0.0,
-        });
+        out.extend_from_slice(&self.integrator.carried_steps());
         out.push(self.amplitude);
         out.push(f64::from(u8::from(self.last_mean_force.is_some())));
         out.push(self.last_mean_force.unwrap_or(0.0));
@@ -322,18 +383,17 @@ impl Simulation {
         }
         let (y, rest) = snapshot.split_at(state::DIM);
         sim.y.copy_from_slice(y);
-        if let Integrator::DormandPrince(dp) = &mut sim.integrator {
-            dp.set_carried_step(rest[0]);
-        }
-        sim.amplitude = rest[1];
-        sim.last_mean_force = match rest[2] {
+        sim.integrator.set_carried_steps([rest[0], rest[1]]);
+        let rest = &rest[2..];
+        sim.amplitude = rest[0];
+        sim.last_mean_force = match rest[1] {
             0.0 => None,
-            1.0 => Some(rest[3]),
+            1.0 => Some(rest[2]),
             _ => return Err("the state's mean-force flag is neither 0 nor 1".into()),
         };
         if let Some(tracker) = sim.tracker.as_mut() {
             let mut t = [0.0; TRACKER_STATE];
-            t.copy_from_slice(&rest[4..]);
+            t.copy_from_slice(&rest[3..]);
             tracker.set_state(&t)?;
         }
         sim.model.c = sim
@@ -400,7 +460,8 @@ mod tests {
             amplitude: AmplitudeSource::Fixed(0.005),
             x0: 0.0,
             v0: 0.0,
-            method: Method::DormandPrince {
+            method: Method::Adaptive {
+                kind: AdaptiveKind::DormandPrince,
                 rtol: 1e-10,
                 max_step: 0.0,
             },

@@ -7,7 +7,7 @@ use std::ffi::CString;
 use tld_fmu::fmi::vars::{GUID, vr};
 use tld_fmu::physics::geometry::Tank;
 use tld_fmu::physics::laws::{DampingLaw, LambdaRange};
-use tld_fmu::simulation::{AmplitudeSource, Config, Inputs, Method, Simulation};
+use tld_fmu::simulation::{AdaptiveKind, AmplitudeSource, Config, Inputs, Method, Simulation};
 
 /// The FMI layer adds nothing and loses nothing: the same run through the C interface and
 /// directly through the simulation is bit-identical.
@@ -29,7 +29,8 @@ fn fmi_layer_is_transparent() {
         amplitude: AmplitudeSource::Fixed(0.005),
         x0: 0.0,
         v0: 0.0,
-        method: Method::DormandPrince {
+        method: Method::Adaptive {
+            kind: AdaptiveKind::DormandPrince,
             rtol: 1e-10,
             max_step: 0.0,
         },

@@ -4,7 +4,7 @@
 use super::vars::{VARIABLES, index_of, vr};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
-use crate::simulation::{AmplitudeSource, Config, Derived, Inputs, Method, Outputs};
+use crate::simulation::{AdaptiveKind, AmplitudeSource, Config, Derived, Inputs, Method, Outputs};
 
 /// Values of all variables, in the order of `VARIABLES` (integers and enumerations as f64).
 #[derive(Clone, Debug, PartialEq)]
@@ -98,15 +98,19 @@ impl Values {
             Some(tol) if !user_tolerance => tol,
             _ => g(vr::SOLVER_TOLERANCE),
         };
-        let method = if g(vr::SOLVER) == 2.0 {
-            Method::Rk4 {
+        // The items of the SolverMethod enumeration (modelDescription.xml).
+        let adaptive = |kind| Method::Adaptive {
+            kind,
+            rtol,
+            max_step: g(vr::SOLVER_MAX_STEP),
+        };
+        let method = match g(vr::SOLVER) as i64 {
+            2 => Method::Rk4 {
                 step: g(vr::SOLVER_FIXED_STEP),
-            }
-        } else {
-            Method::DormandPrince {
-                rtol,
-                max_step: g(vr::SOLVER_MAX_STEP),
-            }
+            },
+            3 => adaptive(AdaptiveKind::Sdirk4),
+            4 => adaptive(AdaptiveKind::Auto),
+            _ => adaptive(AdaptiveKind::DormandPrince),
         };
         Config {
             tank: Tank {

@@ -155,6 +155,31 @@ impl Rhs<{ state::DIM }> for NonlinearTld {
         dy[state::DISSIPATED] = self.c * v * v;
         dy[state::IMPULSE] = f;
     }
+
+    fn jacobian(&self, t: f64, y: &[f64; state::DIM], jac: &mut [[f64; state::DIM]; state::DIM]) {
+        let (x, v) = (y[state::X], y[state::V]);
+        let k = self.stiffness.slope(x);
+        *jac = [[0.0; state::DIM]; state::DIM];
+        jac[state::X][state::V] = 1.0;
+        jac[state::V][state::X] = -k;
+        jac[state::V][state::V] = -self.c;
+        jac[state::WORK_IN][state::V] = -self.base.at(t);
+        jac[state::DISSIPATED][state::V] = 2.0 * self.c * v;
+        jac[state::IMPULSE][state::X] = k;
+        jac[state::IMPULSE][state::V] = self.c;
+    }
+
+    /// The local oscillator x'' + c x' + k(x) x: |lambda| = sqrt(k) when underdamped, the
+    /// larger real root otherwise.
+    fn stiffness(&self, _t: f64, y: &[f64; state::DIM]) -> f64 {
+        let k = self.stiffness.slope(y[state::X]).max(0.0);
+        let disc = 0.25 * self.c * self.c - k;
+        if disc <= 0.0 {
+            k.sqrt()
+        } else {
+            0.5 * self.c + disc.sqrt()
+        }
+    }
 }
 
 #[cfg(test)]
@@ -214,6 +239,40 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn analytic_jacobian_matches_differences() {
+        use crate::solver::Rhs;
+        let m = NonlinearTld {
+            stiffness: PowerLaw::new(5.6, 1.0, 3.0, 0.25),
+            c: 0.3,
+            base: BaseAcceleration {
+                t0: 0.0,
+                a: [0.4, 1.0, -2.0],
+            },
+        };
+        let y = [0.09, -0.3, 0.0, 0.0, 0.0];
+        let mut exact = [[0.0; state::DIM]; state::DIM];
+        m.jacobian(0.2, &y, &mut exact);
+        struct Fd(NonlinearTld);
+        impl Rhs<{ state::DIM }> for Fd {
+            fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
+                self.0.eval(t, y, dy)
+            }
+        }
+        let mut fd = [[0.0; state::DIM]; state::DIM];
+        Fd(m).jacobian(0.2, &y, &mut fd);
+        for i in 0..state::DIM {
+            for j in 0..state::DIM {
+                assert!(
+                    (exact[i][j] - fd[i][j]).abs() < 1e-5 * exact[i][j].abs().max(1.0),
+                    "{i},{j}"
+                );
+            }
+        }
+        // The local frequency at rest is omega_f.
+        assert!((Rhs::stiffness(&m, 0.0, &[0.0; state::DIM]) - 5.6).abs() < 1e-12);
     }
 
     #[test]

@@ -1,15 +1,49 @@
 //! Integrators, generic over a small right-hand-side trait. They know nothing of the model
 //! behind the trait nor of FMI.
 
+mod adaptive;
+mod auto;
 mod dopri5;
 mod rk4;
+mod sdirk4;
 
+pub use adaptive::Controls;
+pub use auto::Auto;
 pub use dopri5::Dopri5;
 pub use rk4::Rk4;
+pub use sdirk4::Sdirk4;
 
 /// y' = f(t, y) for a state of fixed size N.
 pub trait Rhs<const N: usize> {
     fn eval(&self, t: f64, y: &[f64; N], dy: &mut [f64; N]);
+
+    /// Magnitude of the fastest local time scale |lambda|max at (t, y), in 1/s. The default is
+    /// a Gershgorin bound on the Jacobian; a system that knows better should say so.
+    fn stiffness(&self, t: f64, y: &[f64; N]) -> f64 {
+        let mut jac = [[0.0; N]; N];
+        self.jacobian(t, y, &mut jac);
+        jac.iter()
+            .map(|row| row.iter().map(|v| v.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    }
+
+    /// df/dy at (t, y), row i = derivative of f_i. The default differences `eval` forward; a
+    /// system that knows its Jacobian should say so (implicit methods converge on it).
+    fn jacobian(&self, t: f64, y: &[f64; N], jac: &mut [[f64; N]; N]) {
+        let mut f0 = [0.0; N];
+        self.eval(t, y, &mut f0);
+        let mut yp = *y;
+        let mut fp = [0.0; N];
+        for j in 0..N {
+            let d = f64::EPSILON.sqrt() * y[j].abs().max(1e-5);
+            yp[j] = y[j] + d;
+            self.eval(t, &yp, &mut fp);
+            for i in 0..N {
+                jac[i][j] = (fp[i] - f0[i]) / d;
+            }
+            yp[j] = y[j];
+        }
+    }
 }
 
 /// Why an integration over an interval could not be completed.
@@ -92,6 +126,57 @@ mod tests {
                 "suspiciously exact at rtol {rtol}: {e}"
             );
         }
+    }
+
+    #[test]
+    fn sdirk4_meets_its_tolerance_and_is_fourth_order() {
+        let w = 5.6389;
+        for rtol in [1e-6, 1e-8, 1e-10] {
+            let mut m = Sdirk4::new(rtol, [1.0, w], f64::INFINITY, 1_000_000);
+            let mut y = [1.0, 0.0];
+            for k in 0..100 {
+                m.integrate(&Oscillator(w), k as f64 * 0.1, (k + 1) as f64 * 0.1, &mut y)
+                    .expect("step");
+            }
+            let e = error_after(&y, w, 10.0);
+            assert!(e < 100.0 * rtol, "rtol {rtol}: error {e}");
+        }
+        // Fixed steps (max_step below what the tolerance needs): error ratio 2^4 on halving.
+        let run = |h: f64| {
+            let mut m = Sdirk4::new(1.0, [1e9, 1e9], h, 1_000_000);
+            let mut y = [1.0, 0.0];
+            m.integrate(&Oscillator(w), 0.0, 2.0, &mut y).expect("run");
+            error_after(&y, w, 2.0)
+        };
+        let ratio = run(0.02) / run(0.01);
+        assert!((ratio - 16.0).abs() < 2.0, "error ratio {ratio}");
+    }
+
+    /// y' = -L (y - cos t) with L = 1e6: explicit steps are stability-limited to ~3/L, the
+    /// L-stable implicit method takes steps set by cos t alone.
+    #[test]
+    fn sdirk4_takes_large_steps_on_a_stiff_problem() {
+        struct Stiff;
+        impl Rhs<1> for Stiff {
+            fn eval(&self, t: f64, y: &[f64; 1], dy: &mut [f64; 1]) {
+                dy[0] = -1e6 * (y[0] - t.cos());
+            }
+        }
+        let mut implicit = Sdirk4::new(1e-8, [1.0], f64::INFINITY, 100_000);
+        let mut y = [1.0];
+        let stats = implicit
+            .integrate(&Stiff, 0.0, 2.0, &mut y)
+            .expect("implicit");
+        // Exact up to O(1/L): y = cos t + sin t / L ...
+        assert!((y[0] - 2f64.cos()).abs() < 1e-5, "{}", y[0]);
+        assert!(stats.accepted < 1000, "{stats:?}");
+        let mut explicit = Dopri5::new(1e-8, [1.0], f64::INFINITY, 100_000);
+        let mut y = [1.0];
+        let r = explicit.integrate(&Stiff, 0.0, 2.0, &mut y);
+        assert!(
+            matches!(r, Err(SolveError::TooManySteps { .. })),
+            "explicit needs > 1e5 steps: {r:?}"
+        );
     }
 
     #[test]

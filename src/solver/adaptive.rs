@@ -1,0 +1,191 @@
+//! Step-size control shared by the embedded methods: the method supplies one attempted step and
+//! its error estimate; this driver chooses step sizes, lands exactly on the interval's end,
+//! bounds the work and carries the step size to the next interval.
+
+use super::{Rhs, SolveError, SolveStats, all_finite};
+
+/// Error tolerance and work bounds of an adaptive integrator.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Controls<const N: usize> {
+    /// Relative tolerance per step.
+    pub rtol: f64,
+    /// Absolute scale of each component: the error of component i is measured against
+    /// rtol (abs_scale[i] + |y_i|). A component with abs_scale 0 is not error-controlled
+    /// (quadratures that ride along).
+    pub abs_scale: [f64; N],
+    /// Largest internal step (f64::INFINITY: none).
+    pub max_step: f64,
+    /// Most internal steps (accepted + rejected) per interval.
+    pub max_steps: u64,
+}
+
+impl<const N: usize> Controls<N> {
+    /// RMS of the controlled components of `e`, each over its tolerance at y0 and y1.
+    pub fn norm(&self, e: &[f64; N], y0: &[f64; N], y1: &[f64; N]) -> f64 {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for i in 0..N {
+            if self.abs_scale[i] > 0.0 {
+                let sc = self.rtol * (self.abs_scale[i] + y0[i].abs().max(y1[i].abs()));
+                sum += (e[i] / sc).powi(2);
+                n += 1;
+            }
+        }
+        if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
+    }
+}
+
+/// One embedded Runge-Kutta method, as the driver sees it.
+pub(crate) trait Embedded<const N: usize> {
+    /// Order of the error estimate plus one: the step factor is err^(-1/ORDER).
+    const ORDER: f64;
+
+    /// Start of an interval at (t, y): f(t, y) into `f0` (a method may keep it, FSAL).
+    fn begin<F: Rhs<N>>(&mut self, f: &F, t: f64, y: &[f64; N], f0: &mut [f64; N]);
+
+    /// Attempt a step of `h` from (t, y): the new state into `y_new`, the error estimate into
+    /// `err`. Returns false if the attempt failed outright (e.g. Newton did not converge).
+    #[allow(clippy::too_many_arguments)]
+    fn attempt<F: Rhs<N>>(
+        &mut self,
+        f: &F,
+        t: f64,
+        y: &[f64; N],
+        h: f64,
+        y_new: &mut [f64; N],
+        err: &mut [f64; N],
+        stats: &mut SolveStats,
+    ) -> bool;
+
+    /// The last attempt was accepted.
+    fn accepted(&mut self);
+}
+
+/// Starting step from the size of y and y' (Hairer, Norsett & Wanner I, II.4).
+fn initial_step<const N: usize, F: Rhs<N>>(
+    ctl: &Controls<N>,
+    order: f64,
+    f: &F,
+    t: f64,
+    y: &[f64; N],
+    f0: &[f64; N],
+    span: f64,
+) -> f64 {
+    let zero = [0.0; N];
+    let d0 = ctl.norm(y, &zero, &zero);
+    let d1 = ctl.norm(f0, y, y);
+    // From rest the state says nothing of the time scale: let the second estimate decide.
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        0.01 * span
+    } else {
+        0.01 * d0 / d1
+    };
+    let mut y1 = [0.0; N];
+    for i in 0..N {
+        y1[i] = y[i] + h0 * f0[i];
+    }
+    let mut f1 = [0.0; N];
+    f.eval(t + h0, &y1, &mut f1);
+    let mut df = [0.0; N];
+    for i in 0..N {
+        df[i] = (f1[i] - f0[i]) / h0;
+    }
+    let d2 = ctl.norm(&df, y, y);
+    // Nothing moves: any step is exact, so take the whole interval.
+    let h1 = if d1.max(d2) <= 1e-15 {
+        span
+    } else {
+        (0.01 / d1.max(d2)).powf(1.0 / order)
+    };
+    let h = (100.0 * h0).min(h1);
+    if h.is_finite() && h > 0.0 {
+        h
+    } else {
+        1e-6 * span
+    }
+}
+
+/// Advance `y` from `t0` to `t1` (> t0) to tolerance with `method`, starting from the carried
+/// step `*h_next` (0: choose). On error `y` and `*h_next` are left unchanged.
+pub(crate) fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
+    method: &mut M,
+    ctl: &Controls<N>,
+    h_next: &mut f64,
+    f: &F,
+    t0: f64,
+    t1: f64,
+    y: &mut [f64; N],
+) -> Result<SolveStats, SolveError> {
+    let span = t1 - t0;
+    let mut stats = SolveStats::default();
+    let mut z = *y;
+    let mut f0 = [0.0; N];
+    method.begin(f, t0, &z, &mut f0);
+    stats.evaluations += 1;
+    if !all_finite(&f0) || !all_finite(&z) {
+        return Err(SolveError::NonFinite { t: t0 });
+    }
+    let mut h = if *h_next > 0.0 {
+        *h_next
+    } else {
+        initial_step(ctl, M::ORDER, f, t0, &z, &f0, span)
+    };
+    h = h.min(ctl.max_step);
+    let mut t = t0;
+    let (mut y_new, mut err) = ([0.0; N], [0.0; N]);
+    let mut just_rejected = false;
+    let carried = loop {
+        if stats.accepted + stats.rejected >= ctl.max_steps {
+            return Err(SolveError::TooManySteps {
+                limit: ctl.max_steps,
+                t,
+            });
+        }
+        let remaining = t1 - t;
+        let last = h >= remaining;
+        let hs = if last { remaining } else { h };
+        let ok = method.attempt(f, t, &z, hs, &mut y_new, &mut err, &mut stats);
+        let e = if ok && all_finite(&y_new) {
+            ctl.norm(&err, &z, &y_new)
+        } else {
+            f64::INFINITY
+        };
+        if e <= 1.0 {
+            stats.accepted += 1;
+            method.accepted();
+            let fac = if e == 0.0 {
+                5.0
+            } else {
+                (0.9 * e.powf(-1.0 / M::ORDER)).clamp(0.2, 5.0)
+            };
+            let fac = if just_rejected { fac.min(1.0) } else { fac };
+            just_rejected = false;
+            let proposal = (hs * fac).min(ctl.max_step);
+            z = y_new;
+            if last {
+                // A step cut short to land on t1 says little about the natural step.
+                break if hs < h { h.max(proposal) } else { proposal };
+            }
+            t += hs;
+            h = proposal;
+        } else {
+            stats.rejected += 1;
+            just_rejected = true;
+            let fac = if e.is_finite() {
+                (0.9 * e.powf(-1.0 / M::ORDER)).clamp(0.2, 1.0)
+            } else {
+                0.25
+            };
+            h = hs * fac;
+            if h <= 1e-14 * t.abs().max(span) {
+                return Err(if e.is_finite() {
+                    SolveError::StepTooSmall { h, t }
+                } else {
+                    SolveError::NonFinite { t }
+                });
+            }
+        }
+    };
+    *y = z;
+    *h_next = carried;
+    Ok(stats)
+}
