@@ -314,28 +314,33 @@ impl Simulation {
     /// from `inputs` (held when the derivatives are 0). All or nothing: on error the simulation
     /// is unchanged.
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<SolveStats, StepError> {
-        let mut tracker = self.tracker.clone();
-        let mut amplitude = self.amplitude;
-        if let Some(tr) = tracker.as_mut() {
-            tr.update(h, inputs.a, inputs.v);
-            amplitude = tr.estimate();
-        }
         let mut model = self.model;
-        model.c = self
-            .config
-            .viscous_coefficient(self.derived.omega_f, amplitude);
+        let mut tracker = None;
+        if let Some(tr) = &self.tracker {
+            // Only a tracked amplitude moves the damping; a fixed one was applied in new().
+            let mut tr = tr.clone();
+            tr.update(h, inputs.a, inputs.v);
+            model.c = self
+                .config
+                .viscous_coefficient(self.derived.omega_f, tr.estimate());
+            tracker = Some(tr);
+        }
         let [a1, a2] = inputs.a_derivatives;
         model.base = BaseAcceleration {
             t0: t,
             a: [inputs.a, a1, a2],
         };
         let mut y = self.y;
-        let mut integrator = self.integrator.clone();
-        let stats = integrator
+        // The integrators change nothing of themselves when they fail; a runaway found after a
+        // successful integration puts their carried step sizes back.
+        let carried = self.integrator.carried_steps();
+        let stats = self
+            .integrator
             .integrate(&model, t, t + h, &mut y)
             .map_err(StepError::Solver)?;
         let limit = 100.0 * self.config.tank.length;
         if y[state::X].abs() > limit {
+            self.integrator.set_carried_steps(carried);
             return Err(StepError::Runaway {
                 x: y[state::X],
                 limit,
@@ -345,9 +350,10 @@ impl Simulation {
         self.last_mean_force = Some(self.derived.mass_slosh * impulse / h);
         self.y = y;
         self.model = model;
-        self.integrator = integrator;
-        self.tracker = tracker;
-        self.amplitude = amplitude;
+        if let Some(tr) = tracker {
+            self.amplitude = tr.estimate();
+            self.tracker = Some(tr);
+        }
         Ok(stats)
     }
 

@@ -11,8 +11,23 @@ enum Power {
     None,
     /// eta = 1: |xi|^0 = 1, a constant extra stiffness phi.
     Constant,
-    Int(i32),
+    Int(u32),
     Real(f64),
+}
+
+/// x^n by squaring, inlined: `powi` with an exponent known only at run time becomes a call to
+/// a generic routine several times slower, and this sits in the innermost loop.
+#[inline(always)]
+fn int_pow(x: f64, mut n: u32) -> f64 {
+    let (mut base, mut out) = (x, 1.0);
+    while n > 0 {
+        if n & 1 == 1 {
+            out *= base;
+        }
+        base *= base;
+        n >>= 1;
+    }
+    out
 }
 
 /// The restoring characteristic Phi of Eq 2.13 (per unit sloshing mass), xi = 2x/a so that
@@ -35,7 +50,7 @@ impl PowerLaw {
         } else if p == 0.0 {
             Power::Constant
         } else if p.fract() == 0.0 && p <= 64.0 {
-            Power::Int(p as i32)
+            Power::Int(p as u32)
         } else {
             Power::Real(p)
         };
@@ -55,7 +70,7 @@ impl PowerLaw {
         match self.power {
             Power::None => 0.0,
             Power::Constant => self.phi,
-            Power::Int(n) => self.phi * xi.powi(n),
+            Power::Int(n) => self.phi * int_pow(xi, n),
             Power::Real(p) => self.phi * xi.powf(p),
         }
     }

@@ -68,8 +68,8 @@ where
                 other => return other,
             }
         }
-        self.implicit_intervals += 1;
         let mut stats = self.implicit.integrate(f, t0, t1, y)?;
+        self.implicit_intervals += 1;
         stats.rejected += spent.rejected;
         Ok(stats)
     }
