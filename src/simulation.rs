@@ -130,18 +130,26 @@ pub struct Inputs {
     pub a_derivatives: [f64; 2],
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Outputs {
-    pub force: f64,
-    pub force_mean: f64,
-    pub base_shear: f64,
-    pub x: f64,
-    pub v: f64,
-    pub energy_input: f64,
-    pub energy_dissipated: f64,
-    pub energy_stored: f64,
-    pub amplitude: f64,
-    pub zeta: f64,
+/// The outputs of the damper.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// Force of the liquid on the tanks [N].
+    Force,
+    /// Impulse of `Force` over the last step / its length [N].
+    ForceMean,
+    /// `Force` minus the inactive mass's inertia [N].
+    BaseShear,
+    /// Relative displacement [m] and velocity [m/s] of the sloshing mass.
+    X,
+    V,
+    /// Energies [J]: work input, dissipated, stored.
+    EnergyInput,
+    EnergyDissipated,
+    EnergyStored,
+    /// Excitation amplitude in use [m].
+    Amplitude,
+    /// Damping ratio in use.
+    Zeta,
 }
 
 /// Why a communication step was refused. The simulation is left as it was before the step.
@@ -408,42 +416,44 @@ impl Simulation {
         Ok(sim)
     }
 
-    /// Exact first time derivatives of the outputs now (quantities that are constant between
-    /// communication points have derivative 0).
-    pub fn output_derivatives(&self, inputs: &Inputs) -> Outputs {
+    /// The output `which` now.
+    pub fn output(&self, which: Output, inputs: &Inputs) -> f64 {
         let m = self.derived.mass_slosh;
         let (x, v) = (self.y[state::X], self.y[state::V]);
-        let acc = self.model.acceleration(x, v, inputs.a);
-        let force = m * (self.model.c * acc + self.model.stiffness.slope(x) * v);
-        Outputs {
-            force,
-            force_mean: 0.0,
-            base_shear: force - self.derived.mass_inactive * inputs.a_derivatives[0],
-            x: v,
-            v: acc,
-            energy_input: -m * inputs.a * v,
-            energy_dissipated: m * self.model.c * v * v,
-            energy_stored: m * v * (acc + self.model.stiffness.force(x)),
-            amplitude: 0.0,
-            zeta: 0.0,
+        match which {
+            Output::Force => m * self.model.tank_force(x, v),
+            Output::ForceMean => self
+                .last_mean_force
+                .unwrap_or_else(|| self.output(Output::Force, inputs)),
+            Output::BaseShear => {
+                self.output(Output::Force, inputs) - self.derived.mass_inactive * inputs.a
+            }
+            Output::X => x,
+            Output::V => v,
+            Output::EnergyInput => m * (self.initial_energy + self.y[state::WORK_IN]),
+            Output::EnergyDissipated => m * self.y[state::DISSIPATED],
+            Output::EnergyStored => m * self.model.stored_energy(x, v),
+            Output::Amplitude => self.amplitude,
+            Output::Zeta => self.model.c / (2.0 * self.derived.omega_f),
         }
     }
 
-    pub fn outputs(&self, inputs: &Inputs) -> Outputs {
+    /// The exact first time derivative of the output `which` now (0 for quantities constant
+    /// between communication points).
+    pub fn output_derivative(&self, which: Output, inputs: &Inputs) -> f64 {
         let m = self.derived.mass_slosh;
         let (x, v) = (self.y[state::X], self.y[state::V]);
-        let force = m * self.model.tank_force(x, v);
-        Outputs {
-            force,
-            force_mean: self.last_mean_force.unwrap_or(force),
-            base_shear: force - self.derived.mass_inactive * inputs.a,
-            x,
-            v,
-            energy_input: m * (self.initial_energy + self.y[state::WORK_IN]),
-            energy_dissipated: m * self.y[state::DISSIPATED],
-            energy_stored: m * self.model.stored_energy(x, v),
-            amplitude: self.amplitude,
-            zeta: self.model.c / (2.0 * self.derived.omega_f),
+        let acc = self.model.acceleration(x, v, inputs.a);
+        let force = || m * (self.model.c * acc + self.model.stiffness.slope(x) * v);
+        match which {
+            Output::Force => force(),
+            Output::BaseShear => force() - self.derived.mass_inactive * inputs.a_derivatives[0],
+            Output::X => v,
+            Output::V => acc,
+            Output::EnergyInput => -m * inputs.a * v,
+            Output::EnergyDissipated => m * self.model.c * v * v,
+            Output::EnergyStored => m * v * (acc + self.model.stiffness.force(x)),
+            Output::ForceMean | Output::Amplitude | Output::Zeta => 0.0,
         }
     }
 }
@@ -495,7 +505,7 @@ mod tests {
             let t = (k + 1) as f64 * h;
             let exact =
                 0.01 * (-0.02 * w * t).exp() * ((wd * t).cos() + 0.02 * w / wd * (wd * t).sin());
-            worst = worst.max((sim.outputs(&Inputs::default()).x - exact).abs());
+            worst = worst.max((sim.output(Output::X, &Inputs::default()) - exact).abs());
         }
         assert!(worst < 1e-8 * 0.01, "worst error {worst}");
     }
@@ -518,14 +528,19 @@ mod tests {
                 ..Inputs::default()
             };
             sim.step(t, h, &inputs).expect("step");
-            let o = sim.outputs(&inputs);
-            let residual = (o.energy_input - o.energy_stored - o.energy_dissipated).abs();
+            let e = |w| sim.output(w, &inputs);
+            let (input, stored, dissipated) = (
+                e(Output::EnergyInput),
+                e(Output::EnergyStored),
+                e(Output::EnergyDissipated),
+            );
+            let residual = (input - stored - dissipated).abs();
             assert!(
-                residual < 1e-8 * o.energy_input.abs().max(1e-6),
+                residual < 1e-8 * input.abs().max(1e-6),
                 "step {k}: residual {residual}"
             );
-            assert!(o.energy_dissipated >= last_dissipated);
-            last_dissipated = o.energy_dissipated;
+            assert!(dissipated >= last_dissipated);
+            last_dissipated = dissipated;
         }
         assert!(last_dissipated > 0.0);
     }
@@ -584,7 +599,7 @@ mod tests {
                     };
                     sim.step(t, h, &inputs).expect("step");
                     if k > 4000 {
-                        let est = sim.outputs(&inputs).amplitude;
+                        let est = sim.output(Output::Amplitude, &inputs);
                         assert!(
                             (est / amp - 1.0).abs() < 0.05,
                             "w/wf {ratio} rebuild {rebuild}: {est}"

@@ -4,10 +4,10 @@
 use std::ffi::CString;
 
 use super::logger::Logger;
-use super::params::{Values, calculated};
+use super::params::{Values, derived_value, output_of};
 use super::snapshot::Saved;
 use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, index_of, vr};
-use crate::simulation::{Derived, Outputs, Simulation, StepError};
+use crate::simulation::{Simulation, StepError};
 use crate::solver::SolveError;
 
 /// fmi2Status, as a Rust enum.
@@ -196,20 +196,28 @@ impl Instance {
         }
     }
 
+    #[inline]
     pub fn require(&self, allowed: u8, function: &str) -> Result<(), Refusal> {
+        // Broken has no bit: it never passes.
+        if self.phase.bit() & allowed != 0 {
+            Ok(())
+        } else {
+            Err(self.not_allowed(allowed, function))
+        }
+    }
+
+    #[cold]
+    fn not_allowed(&self, allowed: u8, function: &str) -> Refusal {
         if self.phase == Phase::Broken {
-            return Err(refuse(format!(
+            return refuse(format!(
                 "{function} refused: an internal error made this instance unusable; call fmi2Reset or fmi2FreeInstance"
-            )));
+            ));
         }
-        if self.phase.bit() & allowed == 0 {
-            return Err(refuse(format!(
-                "{function} is not allowed in state {:?} (allowed in: {})",
-                self.phase,
-                Phase::describe(allowed)
-            )));
-        }
-        Ok(())
+        refuse(format!(
+            "{function} is not allowed in state {:?} (allowed in: {})",
+            self.phase,
+            Phase::describe(allowed)
+        ))
     }
 
     pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Reply {
@@ -332,17 +340,19 @@ impl Instance {
         Simulation::new(config).map_err(|e| refuse(format!("the parameters are inconsistent: {e}")))
     }
 
-    /// Calculated parameters and outputs now: from the running simulation, or during
-    /// initialisation from one built on the parameters set so far.
-    fn current(&self) -> Result<(Derived, Outputs), Refusal> {
-        let inputs = self.values.inputs(self.a_derivatives);
-        match &self.sim {
-            Some(sim) => Ok((sim.derived(), sim.outputs(&inputs))),
-            None => {
-                let (sim, _) = self.build()?;
-                Ok((sim.derived(), sim.outputs(&inputs)))
-            }
+    /// The running simulation, or during initialisation one built on the parameters set so
+    /// far (kept in `provisional` for the rest of the call).
+    fn simulation<'a>(
+        &'a self,
+        provisional: &'a mut Option<Simulation>,
+    ) -> Result<&'a Simulation, Refusal> {
+        if let Some(sim) = &self.sim {
+            return Ok(sim);
         }
+        if provisional.is_none() {
+            *provisional = Some(self.build()?.0);
+        }
+        provisional.as_ref().ok_or_else(|| refuse("no simulation"))
     }
 
     fn variable(vr: u32, function: &str) -> Result<(usize, &'static Variable), Refusal> {
@@ -364,7 +374,8 @@ impl Instance {
         mut put: impl FnMut(usize, f64),
     ) -> Reply {
         self.require(allow::GET, function)?;
-        let mut cache: Option<(Derived, Outputs)> = None;
+        let mut provisional = None;
+        let inputs = self.values.inputs(self.a_derivatives);
         for (k, &r) in vrs.iter().enumerate() {
             let (index, var) = Self::variable(r, function)?;
             if !Self::type_matches(var, ty) {
@@ -373,15 +384,19 @@ impl Instance {
                     var.name, var.ty
                 )));
             }
+            let no_value = || refuse(format!("{function}: '{}' has no value", var.name));
             let value = match var.causality {
                 Causality::Parameter | Causality::Input | Causality::Local => self.values.at(index),
-                Causality::CalculatedParameter | Causality::Output => {
-                    let (derived, outputs) = match &cache {
-                        Some(c) => c,
-                        None => cache.insert(self.current()?),
+                Causality::CalculatedParameter => {
+                    let derived = match &self.sim {
+                        Some(sim) => sim.derived(),
+                        None => self.values.config(None, false).derived(),
                     };
-                    calculated(r, derived, outputs)
-                        .ok_or_else(|| refuse(format!("{function}: '{}' has no value", var.name)))?
+                    derived_value(r, &derived).ok_or_else(no_value)?
+                }
+                Causality::Output => {
+                    let which = output_of(r).ok_or_else(no_value)?;
+                    self.simulation(&mut provisional)?.output(which, &inputs)
                 }
             };
             put(k, value);
@@ -483,20 +498,19 @@ impl Instance {
             .sim
             .as_ref()
             .ok_or_else(|| refuse(format!("{F}: not initialised")))?;
-        let derivatives = sim.output_derivatives(&self.values.inputs(self.a_derivatives));
+        let inputs = self.values.inputs(self.a_derivatives);
         for (k, (&r, &order)) in vrs.iter().zip(orders).enumerate() {
             let (_, var) = Self::variable(r, F)?;
-            if var.causality != Causality::Output {
+            let Some(which) = output_of(r) else {
                 return Err(refuse(format!("{F}: '{}' is not an output", var.name)));
-            }
+            };
             if order != 1 {
                 return Err(refuse(format!(
                     "{F}: order {order} of '{}' is not offered (maxOutputDerivativeOrder = 1)",
                     var.name
                 )));
             }
-            let value = calculated(r, &sim.derived(), &derivatives)
-                .ok_or_else(|| refuse(format!("{F}: '{}' has no derivative", var.name)))?;
+            let value = sim.output_derivative(which, &inputs);
             put(k, value);
         }
         Ok(Status::Ok)

@@ -4,7 +4,7 @@
 use super::vars::{VARIABLES, index_of, vr};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
-use crate::simulation::{AdaptiveKind, AmplitudeSource, Config, Derived, Inputs, Method, Outputs};
+use crate::simulation::{AdaptiveKind, AmplitudeSource, Config, Derived, Inputs, Method, Output};
 
 /// Values of all variables, in the order of `VARIABLES` (integers and enumerations as f64).
 #[derive(Clone, Debug, PartialEq)]
@@ -137,23 +137,30 @@ impl Values {
     }
 }
 
-/// The value of a calculated parameter or output, by value reference.
-pub fn calculated(vr: u32, derived: &Derived, outputs: &Outputs) -> Option<f64> {
+/// The value of a calculated parameter, by value reference.
+pub fn derived_value(vr: u32, derived: &Derived) -> Option<f64> {
     Some(match vr {
         vr::OMEGA_F => derived.omega_f,
         vr::MASS_LIQUID => derived.mass_liquid,
         vr::MASS_SLOSH => derived.mass_slosh,
         vr::MASS_INACTIVE => derived.mass_inactive,
-        vr::FORCE => outputs.force,
-        vr::FORCE_MEAN => outputs.force_mean,
-        vr::BASE_SHEAR => outputs.base_shear,
-        vr::SLOSH_X => outputs.x,
-        vr::SLOSH_V => outputs.v,
-        vr::ENERGY_INPUT => outputs.energy_input,
-        vr::ENERGY_DISSIPATED => outputs.energy_dissipated,
-        vr::ENERGY_STORED => outputs.energy_stored,
-        vr::A_E_ESTIMATE => outputs.amplitude,
-        vr::ZETA_EFFECTIVE => outputs.zeta,
+        _ => return None,
+    })
+}
+
+/// The simulation output an output variable shows, by value reference.
+pub fn output_of(vr: u32) -> Option<Output> {
+    Some(match vr {
+        vr::FORCE => Output::Force,
+        vr::FORCE_MEAN => Output::ForceMean,
+        vr::BASE_SHEAR => Output::BaseShear,
+        vr::SLOSH_X => Output::X,
+        vr::SLOSH_V => Output::V,
+        vr::ENERGY_INPUT => Output::EnergyInput,
+        vr::ENERGY_DISSIPATED => Output::EnergyDissipated,
+        vr::ENERGY_STORED => Output::EnergyStored,
+        vr::A_E_ESTIMATE => Output::Amplitude,
+        vr::ZETA_EFFECTIVE => Output::Zeta,
         _ => return None,
     })
 }
