@@ -354,7 +354,10 @@ impl Simulation {
                 limit,
             });
         }
-        let impulse = y[state::IMPULSE] - self.y[state::IMPULSE];
+        // The impulse of the force on the tank over the step, from v' = -a_b - f: for a
+        // Runge-Kutta step h sum b_i f_i = -dv - h sum b_i a_b(t_i), and the quadrature of the
+        // (at most quadratic) input is exact, so this equals integrating f alongside.
+        let impulse = -(y[state::V] - self.y[state::V]) - model.base.integral(h);
         self.last_mean_force = Some(self.derived.mass_slosh * impulse / h);
         self.y = y;
         self.model = model;

@@ -102,9 +102,7 @@ pub mod state {
     pub const WORK_IN: usize = 2;
     /// Dissipated energy, integral of c x'^2.
     pub const DISSIPATED: usize = 3;
-    /// Impulse of the force on the tank, integral of c x' + Phi(x).
-    pub const IMPULSE: usize = 4;
-    pub const DIM: usize = 5;
+    pub const DIM: usize = 4;
 }
 
 /// Base (tank) acceleration over one communication step: a Taylor polynomial about the step's
@@ -127,6 +125,11 @@ impl BaseAcceleration {
     pub fn at(&self, t: f64) -> f64 {
         let s = t - self.t0;
         self.a[0] + s * (self.a[1] + 0.5 * s * self.a[2])
+    }
+
+    /// Integral of a from t0 to t0 + h.
+    pub fn integral(&self, h: f64) -> f64 {
+        h * (self.a[0] + h * (0.5 * self.a[1] + h * self.a[2] / 6.0))
     }
 }
 
@@ -168,7 +171,6 @@ impl Rhs<{ state::DIM }> for NonlinearTld {
         dy[state::V] = -a_b - f;
         dy[state::WORK_IN] = -a_b * v;
         dy[state::DISSIPATED] = self.c * v * v;
-        dy[state::IMPULSE] = f;
     }
 
     fn jacobian(&self, t: f64, y: &[f64; state::DIM], jac: &mut [[f64; state::DIM]; state::DIM]) {
@@ -180,8 +182,6 @@ impl Rhs<{ state::DIM }> for NonlinearTld {
         jac[state::V][state::V] = -self.c;
         jac[state::WORK_IN][state::V] = -self.base.at(t);
         jac[state::DISSIPATED][state::V] = 2.0 * self.c * v;
-        jac[state::IMPULSE][state::X] = k;
-        jac[state::IMPULSE][state::V] = self.c;
     }
 
     /// The local oscillator x'' + c x' + k(x) x: |lambda| = sqrt(k) when underdamped, the
@@ -267,7 +267,7 @@ mod tests {
                 a: [0.4, 1.0, -2.0],
             },
         };
-        let y = [0.09, -0.3, 0.0, 0.0, 0.0];
+        let y = [0.09, -0.3, 0.0, 0.0];
         let mut exact = [[0.0; state::DIM]; state::DIM];
         m.jacobian(0.2, &y, &mut exact);
         struct Fd(NonlinearTld);
