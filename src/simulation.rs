@@ -4,6 +4,7 @@
 use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
+use crate::physics::linear::{Mode, ModeState};
 use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, state};
 use crate::solver::{Auto, Dopri5, Rk4, Sdirk4, SolveError, SolveStats};
 
@@ -41,8 +42,21 @@ pub enum AdaptiveKind {
     Auto,
 }
 
+/// Most modes the linear model carries (their masses fall as 1/(2n-1)^3).
+pub const MAX_MODES: u32 = 50;
+
+/// Which model of the seed's ladder the damper runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelKind {
+    /// `modes` linear sloshing modes (Eqs 2.1, 2.2), advanced exactly.
+    Linear { modes: u32 },
+    /// The impact-characteristic model (Eq 2.11 with Eq 2.13).
+    Nonlinear,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Config {
+    pub model: ModelKind,
     pub tank: Tank,
     /// Number of identical tanks acting together.
     pub tanks: u32,
@@ -69,22 +83,32 @@ pub struct Derived {
 }
 
 impl Config {
+    /// Number of sloshing modes the model carries.
+    fn mode_count(&self) -> u32 {
+        match self.model {
+            ModelKind::Linear { modes } => modes.max(1),
+            ModelKind::Nonlinear => 1,
+        }
+    }
+
     pub fn derived(&self) -> Derived {
         let n = f64::from(self.tanks);
-        let mode = self.tank.fundamental();
         let liquid = self.tank.liquid_mass() * n;
-        let slosh = mode.mass * n;
+        let slosh = (1..=self.mode_count())
+            .map(|k| self.tank.mode(k).mass)
+            .sum::<f64>()
+            * n;
         Derived {
-            omega_f: mode.omega,
+            omega_f: self.tank.fundamental().omega,
             mass_liquid: liquid,
             mass_slosh: slosh,
             mass_inactive: liquid - slosh,
         }
     }
 
-    /// c = 2 zeta omega_f of Eq 2.11 for the excitation amplitude `amplitude`.
-    fn viscous_coefficient(&self, omega_f: f64, amplitude: f64) -> f64 {
-        2.0 * omega_f * self.damping.zeta(amplitude, self.tank.length, self.lambda)
+    /// The damping ratio of the sloshing modes for the excitation amplitude `amplitude`.
+    fn zeta(&self, amplitude: f64) -> f64 {
+        self.damping.zeta(amplitude, self.tank.length, self.lambda)
     }
 
     /// Checks that involve several parameters. Err: the configuration cannot be simulated;
@@ -107,6 +131,13 @@ impl Config {
         if r > 0.15 {
             warnings.push(format!(
                 "depth ratio h/a = {r:.3} exceeds 0.15: the shallow-water model is outside its validity"
+            ));
+        }
+        if let ModelKind::Linear { modes } = self.model
+            && !(1..=MAX_MODES).contains(&modes)
+        {
+            return Err(format!(
+                "modes = {modes}: the linear model carries 1 to {MAX_MODES} modes"
             ));
         }
         if self.x0.abs() > self.tank.length {
@@ -173,9 +204,9 @@ impl std::fmt::Display for StepError {
     }
 }
 
-/// Length of [`Simulation::snapshot`]: state, two carried steps, amplitude, mean force (flag
-/// and value), amplitude estimator.
-pub const SNAPSHOT_LEN: usize = state::DIM + 5 + TRACKER_STATE;
+/// Numbers in [`Simulation::snapshot`] besides the model's state: two carried steps,
+/// amplitude, mean force (flag and value), amplitude estimator.
+const SNAPSHOT_EXTRA: usize = 5 + TRACKER_STATE;
 
 #[derive(Clone, Debug, PartialEq)]
 enum Integrator {
@@ -221,18 +252,44 @@ impl Integrator {
     }
 }
 
+/// What evolves, by model.
+// One per instance: the size difference costs nothing, boxing would add an indirection to
+// every step.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug, PartialEq)]
+enum Dynamics {
+    Nonlinear {
+        model: NonlinearTld,
+        integrator: Integrator,
+        /// State per unit sloshing mass, see `physics::nonlinear::state`.
+        y: [f64; state::DIM],
+    },
+    /// Each mode with its total modal mass and state; the first is the fundamental.
+    Linear { modes: Vec<(Mode, f64, ModeState)> },
+}
+
+impl Dynamics {
+    /// Numbers of the model's state in a snapshot.
+    fn state_len(&self) -> usize {
+        match self {
+            Dynamics::Nonlinear { .. } => state::DIM,
+            Dynamics::Linear { modes } => 4 * modes.len(),
+        }
+    }
+}
+
 /// A configured damper and its state.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Simulation {
     config: Config,
     derived: Derived,
-    model: NonlinearTld,
-    integrator: Integrator,
+    dynamics: Dynamics,
     tracker: Option<AmplitudeTracker>,
-    /// State per unit sloshing mass, see `physics::nonlinear::state`.
-    y: [f64; state::DIM],
+    /// Stored energy at the start [J]: counted as input.
     initial_energy: f64,
     amplitude: f64,
+    /// Damping ratio in use.
+    zeta: f64,
     last_mean_force: Option<f64>,
 }
 
@@ -242,9 +299,88 @@ impl Simulation {
         let derived = config.derived();
         let omega_f = derived.omega_f;
         let length = config.tank.length;
-        let stiffness = PowerLaw::new(omega_f, config.phi, config.eta, length);
-        let half = 0.5 * length;
-        let integrator = match config.method {
+        let (amplitude, tracker) = match config.amplitude {
+            AmplitudeSource::Fixed(a_e) => (a_e, None),
+            AmplitudeSource::Tracked { tau, prior } => {
+                let period = 2.0 * std::f64::consts::PI / omega_f;
+                let tau = if tau > 0.0 { tau } else { 2.0 * period };
+                // The velocity rebuild leaks at w_f/20: 0.5 % gain error at w_f/2, undone exactly.
+                (
+                    prior,
+                    Some(AmplitudeTracker::new(tau, 0.05 * omega_f, prior)),
+                )
+            }
+        };
+        let zeta = config.zeta(amplitude);
+        let tanks = f64::from(config.tanks);
+        let (dynamics, initial_energy) = match config.model {
+            ModelKind::Nonlinear => {
+                let stiffness = PowerLaw::new(omega_f, config.phi, config.eta, length);
+                let model = NonlinearTld {
+                    stiffness,
+                    c: 2.0 * zeta * omega_f,
+                    base: BaseAcceleration::held(0.0),
+                };
+                let mut y = [0.0; state::DIM];
+                y[state::X] = config.x0;
+                y[state::V] = config.v0;
+                let energy = derived.mass_slosh * model.stored_energy(config.x0, config.v0);
+                (
+                    Dynamics::Nonlinear {
+                        model,
+                        integrator: Self::integrator(&config, omega_f),
+                        y,
+                    },
+                    energy,
+                )
+            }
+            ModelKind::Linear { .. } => {
+                let modes: Vec<(Mode, f64, ModeState)> = (1..=config.mode_count())
+                    .map(|k| {
+                        let m = config.tank.mode(k);
+                        // The initial conditions belong to the fundamental mode.
+                        let (x, v) = if k == 1 {
+                            (config.x0, config.v0)
+                        } else {
+                            (0.0, 0.0)
+                        };
+                        (
+                            Mode {
+                                omega: m.omega,
+                                zeta,
+                            },
+                            m.mass * tanks,
+                            ModeState {
+                                x,
+                                v,
+                                ..ModeState::default()
+                            },
+                        )
+                    })
+                    .collect();
+                let energy = modes
+                    .iter()
+                    .map(|(mode, mass, s)| mass * mode.stored_energy(s))
+                    .sum();
+                (Dynamics::Linear { modes }, energy)
+            }
+        };
+        let sim = Simulation {
+            config,
+            derived,
+            dynamics,
+            tracker,
+            initial_energy,
+            amplitude,
+            zeta,
+            last_mean_force: None,
+        };
+        Ok((sim, warnings))
+    }
+
+    fn integrator(config: &Config, omega_f: f64) -> Integrator {
+        let half = 0.5 * config.tank.length;
+        match config.method {
             Method::Adaptive {
                 kind,
                 rtol,
@@ -273,41 +409,7 @@ impl Simulation {
                 max_step: step,
                 max_steps: config.max_substeps,
             }),
-        };
-        let (amplitude, tracker) = match config.amplitude {
-            AmplitudeSource::Fixed(a_e) => (a_e, None),
-            AmplitudeSource::Tracked { tau, prior } => {
-                let period = 2.0 * std::f64::consts::PI / omega_f;
-                let tau = if tau > 0.0 { tau } else { 2.0 * period };
-                // The velocity rebuild leaks at w_f/20: 0.5 % gain error at w_f/2, undone exactly.
-                (
-                    prior,
-                    Some(AmplitudeTracker::new(tau, 0.05 * omega_f, prior)),
-                )
-            }
-        };
-        let c = config.viscous_coefficient(omega_f, amplitude);
-        let model = NonlinearTld {
-            stiffness,
-            c,
-            base: BaseAcceleration::held(0.0),
-        };
-        let mut y = [0.0; state::DIM];
-        y[state::X] = config.x0;
-        y[state::V] = config.v0;
-        let initial_energy = model.stored_energy(config.x0, config.v0);
-        let sim = Simulation {
-            config,
-            derived,
-            model,
-            integrator,
-            tracker,
-            y,
-            initial_energy,
-            amplitude,
-            last_mean_force: None,
-        };
-        Ok((sim, warnings))
+        }
     }
 
     pub fn config(&self) -> &Config {
@@ -322,45 +424,85 @@ impl Simulation {
     /// from `inputs` (held when the derivatives are 0). All or nothing: on error the simulation
     /// is unchanged.
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<SolveStats, StepError> {
-        let mut model = self.model;
+        let mut zeta = self.zeta;
         let mut tracker = None;
         if let Some(tr) = &self.tracker {
             // Only a tracked amplitude moves the damping; a fixed one was applied in new().
             let mut tr = tr.clone();
             tr.update(h, inputs.a, inputs.v);
-            model.c = self
-                .config
-                .viscous_coefficient(self.derived.omega_f, tr.estimate());
+            zeta = self.config.zeta(tr.estimate());
             tracker = Some(tr);
         }
         let [a1, a2] = inputs.a_derivatives;
-        model.base = BaseAcceleration {
+        let base = BaseAcceleration {
             t0: t,
             a: [inputs.a, a1, a2],
         };
-        let mut y = self.y;
-        // The integrators change nothing of themselves when they fail; a runaway found after a
-        // successful integration puts their carried step sizes back.
-        let carried = self.integrator.carried_steps();
-        let stats = self
-            .integrator
-            .integrate(&model, t, t + h, &mut y)
-            .map_err(StepError::Solver)?;
         let limit = 100.0 * self.config.tank.length;
-        if y[state::X].abs() > limit {
-            self.integrator.set_carried_steps(carried);
-            return Err(StepError::Runaway {
-                x: y[state::X],
-                limit,
-            });
-        }
-        // The impulse of the force on the tank over the step, from v' = -a_b - f: for a
-        // Runge-Kutta step h sum b_i f_i = -dv - h sum b_i a_b(t_i), and the quadrature of the
-        // (at most quadratic) input is exact, so this equals integrating f alongside.
-        let impulse = -(y[state::V] - self.y[state::V]) - model.base.integral(h);
-        self.last_mean_force = Some(self.derived.mass_slosh * impulse / h);
-        self.y = y;
-        self.model = model;
+        let mass = self.derived.mass_slosh;
+        let omega_f = self.derived.omega_f;
+        // The impulse of each mode's force on the tank over the step follows from its velocity
+        // change, v' = -a_b - f: integral f = -dv - integral a_b (for a Runge-Kutta step too:
+        // h sum b_i f_i = -dv - h sum b_i a_b(t_i), the input's quadrature being exact).
+        let (stats, impulse) = match &mut self.dynamics {
+            Dynamics::Nonlinear {
+                model,
+                integrator,
+                y,
+            } => {
+                let mut next_model = *model;
+                next_model.c = 2.0 * zeta * omega_f;
+                next_model.base = base;
+                let mut next = *y;
+                // The integrators change nothing of themselves when they fail; a runaway found
+                // after a successful integration puts their carried step sizes back.
+                let carried = integrator.carried_steps();
+                let stats = integrator
+                    .integrate(&next_model, t, t + h, &mut next)
+                    .map_err(StepError::Solver)?;
+                if next[state::X].abs() > limit {
+                    integrator.set_carried_steps(carried);
+                    return Err(StepError::Runaway {
+                        x: next[state::X],
+                        limit,
+                    });
+                }
+                let impulse = mass * (-(next[state::V] - y[state::V]) - base.integral(h));
+                *y = next;
+                *model = next_model;
+                (stats, impulse)
+            }
+            Dynamics::Linear { modes } => {
+                // Exact propagation cannot fail; only the fundamental mode can run away (the
+                // higher ones respond less), so it is checked before anything changes.
+                let mut first = modes[0];
+                first.0.zeta = zeta;
+                first.0.advance(&mut first.2, h, &base);
+                if first.2.x.is_nan() || first.2.x.abs() > limit {
+                    return Err(StepError::Runaway {
+                        x: first.2.x,
+                        limit,
+                    });
+                }
+                let mut impulse = first.1 * (-(first.2.v - modes[0].2.v) - base.integral(h));
+                modes[0] = first;
+                for (mode, m, s) in modes.iter_mut().skip(1) {
+                    mode.zeta = zeta;
+                    let v0 = s.v;
+                    mode.advance(s, h, &base);
+                    impulse += *m * (-(s.v - v0) - base.integral(h));
+                }
+                (
+                    SolveStats {
+                        accepted: 1,
+                        ..SolveStats::default()
+                    },
+                    impulse,
+                )
+            }
+        };
+        self.last_mean_force = Some(impulse / h);
+        self.zeta = zeta;
         if let Some(tr) = tracker {
             self.amplitude = tr.estimate();
             self.tracker = Some(tr);
@@ -371,9 +513,20 @@ impl Simulation {
     /// Everything that evolves, as a flat list of numbers (what the configuration does not
     /// determine). Restore with [`Simulation::restore`] and the same configuration.
     pub fn snapshot(&self) -> Vec<f64> {
-        let mut out = Vec::with_capacity(SNAPSHOT_LEN);
-        out.extend_from_slice(&self.y);
-        out.extend_from_slice(&self.integrator.carried_steps());
+        let mut out = Vec::with_capacity(self.dynamics.state_len() + SNAPSHOT_EXTRA);
+        let carried = match &self.dynamics {
+            Dynamics::Nonlinear { integrator, y, .. } => {
+                out.extend_from_slice(y);
+                integrator.carried_steps()
+            }
+            Dynamics::Linear { modes } => {
+                for (_, _, s) in modes {
+                    out.extend_from_slice(&[s.x, s.v, s.work_in, s.dissipated]);
+                }
+                [0.0; 2]
+            }
+        };
+        out.extend_from_slice(&carried);
         out.push(self.amplitude);
         out.push(f64::from(u8::from(self.last_mean_force.is_some())));
         out.push(self.last_mean_force.unwrap_or(0.0));
@@ -389,18 +542,34 @@ impl Simulation {
     /// The simulation `config` describes, in the state `snapshot` recorded.
     pub fn restore(config: Config, snapshot: &[f64]) -> Result<Self, String> {
         let (mut sim, _) = Simulation::new(config)?;
-        if snapshot.len() != SNAPSHOT_LEN {
+        let n = sim.dynamics.state_len();
+        if snapshot.len() != n + SNAPSHOT_EXTRA {
             return Err(format!(
-                "a state has {SNAPSHOT_LEN} numbers, this one {}",
+                "a state of this model has {} numbers, this one {}",
+                n + SNAPSHOT_EXTRA,
                 snapshot.len()
             ));
         }
         if snapshot.iter().any(|v| !v.is_finite()) {
             return Err("the state holds non-finite numbers".into());
         }
-        let (y, rest) = snapshot.split_at(state::DIM);
-        sim.y.copy_from_slice(y);
-        sim.integrator.set_carried_steps([rest[0], rest[1]]);
+        let (model_state, rest) = snapshot.split_at(n);
+        match &mut sim.dynamics {
+            Dynamics::Nonlinear { integrator, y, .. } => {
+                y.copy_from_slice(model_state);
+                integrator.set_carried_steps([rest[0], rest[1]]);
+            }
+            Dynamics::Linear { modes } => {
+                for ((_, _, s), v) in modes.iter_mut().zip(model_state.chunks_exact(4)) {
+                    *s = ModeState {
+                        x: v[0],
+                        v: v[1],
+                        work_in: v[2],
+                        dissipated: v[3],
+                    };
+                }
+            }
+        }
         let rest = &rest[2..];
         sim.amplitude = rest[0];
         sim.last_mean_force = match rest[1] {
@@ -413,49 +582,103 @@ impl Simulation {
             t.copy_from_slice(&rest[3..]);
             tracker.set_state(&t)?;
         }
-        sim.model.c = sim
-            .config
-            .viscous_coefficient(sim.derived.omega_f, sim.amplitude);
+        sim.zeta = sim.config.zeta(sim.amplitude);
         Ok(sim)
     }
 
     /// The output `which` now.
     pub fn output(&self, which: Output, inputs: &Inputs) -> f64 {
-        let m = self.derived.mass_slosh;
-        let (x, v) = (self.y[state::X], self.y[state::V]);
-        match which {
-            Output::Force => m * self.model.tank_force(x, v),
-            Output::ForceMean => self
+        match (which, &self.dynamics) {
+            (Output::ForceMean, _) => self
                 .last_mean_force
                 .unwrap_or_else(|| self.output(Output::Force, inputs)),
-            Output::BaseShear => {
+            (Output::BaseShear, _) => {
                 self.output(Output::Force, inputs) - self.derived.mass_inactive * inputs.a
             }
-            Output::X => x,
-            Output::V => v,
-            Output::EnergyInput => m * (self.initial_energy + self.y[state::WORK_IN]),
-            Output::EnergyDissipated => m * self.y[state::DISSIPATED],
-            Output::EnergyStored => m * self.model.stored_energy(x, v),
-            Output::Amplitude => self.amplitude,
-            Output::Zeta => self.model.c / (2.0 * self.derived.omega_f),
+            (Output::EnergyInput, _) => {
+                self.initial_energy
+                    + self.sum(|_, m, s| m * s.work_in, |m, y| m * y[state::WORK_IN])
+            }
+            (Output::EnergyDissipated, _) => {
+                self.sum(|_, m, s| m * s.dissipated, |m, y| m * y[state::DISSIPATED])
+            }
+            (Output::EnergyStored, Dynamics::Nonlinear { model, y, .. }) => {
+                self.derived.mass_slosh * model.stored_energy(y[state::X], y[state::V])
+            }
+            (Output::EnergyStored, Dynamics::Linear { modes }) => modes
+                .iter()
+                .map(|(mode, m, s)| m * mode.stored_energy(s))
+                .sum(),
+            (Output::Force, Dynamics::Nonlinear { model, y, .. }) => {
+                self.derived.mass_slosh * model.tank_force(y[state::X], y[state::V])
+            }
+            (Output::Force, Dynamics::Linear { modes }) => modes
+                .iter()
+                .map(|(mode, m, s)| m * mode.tank_force(s))
+                .sum(),
+            (Output::X, Dynamics::Nonlinear { y, .. }) => y[state::X],
+            (Output::X, Dynamics::Linear { modes }) => modes[0].2.x,
+            (Output::V, Dynamics::Nonlinear { y, .. }) => y[state::V],
+            (Output::V, Dynamics::Linear { modes }) => modes[0].2.v,
+            (Output::Amplitude, _) => self.amplitude,
+            (Output::Zeta, _) => self.zeta,
+        }
+    }
+
+    /// A sum over the modes of the linear model, or the nonlinear model's state.
+    fn sum(
+        &self,
+        linear: impl Fn(&Mode, f64, &ModeState) -> f64,
+        nonlinear: impl Fn(f64, &[f64; state::DIM]) -> f64,
+    ) -> f64 {
+        match &self.dynamics {
+            Dynamics::Nonlinear { y, .. } => nonlinear(self.derived.mass_slosh, y),
+            Dynamics::Linear { modes } => {
+                modes.iter().map(|(mode, m, s)| linear(mode, *m, s)).sum()
+            }
         }
     }
 
     /// The exact first time derivative of the output `which` now (0 for quantities constant
     /// between communication points).
     pub fn output_derivative(&self, which: Output, inputs: &Inputs) -> f64 {
-        let m = self.derived.mass_slosh;
-        let (x, v) = (self.y[state::X], self.y[state::V]);
-        let acc = self.model.acceleration(x, v, inputs.a);
-        let force = || m * (self.model.c * acc + self.model.stiffness.slope(x) * v);
+        let a = inputs.a;
+        // Per mode (or the nonlinear model): mass, x, v, damping c, stiffness k(x) x and slope.
+        let terms: Vec<(f64, f64, f64, f64, f64, f64)> = match &self.dynamics {
+            Dynamics::Nonlinear { model, y, .. } => {
+                let (x, v) = (y[state::X], y[state::V]);
+                vec![(
+                    self.derived.mass_slosh,
+                    x,
+                    v,
+                    model.c,
+                    model.stiffness.force(x),
+                    model.stiffness.slope(x),
+                )]
+            }
+            Dynamics::Linear { modes } => modes
+                .iter()
+                .map(|(mode, m, s)| {
+                    let w2 = mode.omega * mode.omega;
+                    (*m, s.x, s.v, 2.0 * mode.zeta * mode.omega, w2 * s.x, w2)
+                })
+                .collect(),
+        };
+        let acc = |&(_, _, v, c, f, _): &(f64, f64, f64, f64, f64, f64)| -a - c * v - f;
+        let force = || {
+            terms
+                .iter()
+                .map(|t| t.0 * (t.3 * acc(t) + t.5 * t.2))
+                .sum::<f64>()
+        };
         match which {
             Output::Force => force(),
             Output::BaseShear => force() - self.derived.mass_inactive * inputs.a_derivatives[0],
-            Output::X => v,
-            Output::V => acc,
-            Output::EnergyInput => -m * inputs.a * v,
-            Output::EnergyDissipated => m * self.model.c * v * v,
-            Output::EnergyStored => m * v * (acc + self.model.stiffness.force(x)),
+            Output::X => terms[0].2,
+            Output::V => acc(&terms[0]),
+            Output::EnergyInput => terms.iter().map(|t| -t.0 * a * t.2).sum(),
+            Output::EnergyDissipated => terms.iter().map(|t| t.0 * t.3 * t.2 * t.2).sum(),
+            Output::EnergyStored => terms.iter().map(|t| t.0 * t.2 * (acc(t) + t.4)).sum(),
             Output::ForceMean | Output::Amplitude | Output::Zeta => 0.0,
         }
     }
@@ -467,6 +690,7 @@ mod tests {
 
     fn config() -> Config {
         Config {
+            model: ModelKind::Nonlinear,
             tank: Tank::TABLE_2_1,
             tanks: 1,
             eta: 2.0,

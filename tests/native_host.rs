@@ -8,7 +8,7 @@ use tld_fmu::fmi::vars::{GUID, vr};
 use tld_fmu::physics::geometry::Tank;
 use tld_fmu::physics::laws::{DampingLaw, LambdaRange};
 use tld_fmu::simulation::{
-    AdaptiveKind, AmplitudeSource, Config, Inputs, Method, Output, Simulation,
+    AdaptiveKind, AmplitudeSource, Config, Inputs, Method, ModelKind, Output, Simulation,
 };
 
 /// The FMI layer adds nothing and loses nothing: the same run through the C interface and
@@ -19,6 +19,7 @@ fn fmi_layer_is_transparent() {
     inst.initialise();
     let x_fmu = inst.run_harmonic(500, 0.01);
     let (mut sim, _) = Simulation::new(Config {
+        model: ModelKind::Nonlinear,
         tank: Tank::TABLE_2_1,
         tanks: 1,
         eta: 2.0,
@@ -405,10 +406,11 @@ fn out_of_range_and_inconsistent_parameters() {
         "not an enumeration item"
     );
     assert_eq!(
-        inst.set_integer(vr::MODEL, 1),
+        inst.set_integer(vr::MODEL, 3),
         ERROR,
-        "Linear is not offered yet"
+        "SloshingSlamming is not offered yet"
     );
+    assert_eq!(inst.set_integer(vr::MODES, 51), ERROR, "at most 50 modes");
     assert_eq!(inst.set_integer(vr::TANKS, 0), ERROR);
     assert_eq!(
         inst.get_real(vr::TANK_LENGTH).0,

@@ -4,7 +4,9 @@
 use super::vars::{VARIABLES, index_of, vr};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
-use crate::simulation::{AdaptiveKind, AmplitudeSource, Config, Derived, Inputs, Method, Output};
+use crate::simulation::{
+    AdaptiveKind, AmplitudeSource, Config, Derived, Inputs, Method, ModelKind, Output,
+};
 
 /// Values of all variables, in the order of `VARIABLES` (integers and enumerations as f64).
 #[derive(Clone, Debug, PartialEq)]
@@ -112,7 +114,15 @@ impl Values {
             4 => adaptive(AdaptiveKind::Auto),
             _ => adaptive(AdaptiveKind::DormandPrince),
         };
+        let model = if g(vr::MODEL) == 1.0 {
+            ModelKind::Linear {
+                modes: g(vr::MODES) as u32,
+            }
+        } else {
+            ModelKind::Nonlinear
+        };
         Config {
+            model,
             tank: Tank {
                 length: g(vr::TANK_LENGTH),
                 breadth: g(vr::TANK_BREADTH),

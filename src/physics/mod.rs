@@ -4,4 +4,5 @@
 pub mod amplitude;
 pub mod geometry;
 pub mod laws;
+pub mod linear;
 pub mod nonlinear;
