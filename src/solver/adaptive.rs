@@ -35,7 +35,7 @@ impl<const N: usize> Controls<N> {
 }
 
 /// One embedded Runge-Kutta method, as the driver sees it.
-pub(crate) trait Embedded<const N: usize> {
+pub trait Embedded<const N: usize>: Default {
     /// Order of the error estimate plus one: the step factor is err^(-1/ORDER).
     const ORDER: f64;
 
@@ -53,11 +53,67 @@ pub(crate) trait Embedded<const N: usize> {
         h: f64,
         y_new: &mut [f64; N],
         err: &mut [f64; N],
+        ctl: &Controls<N>,
         stats: &mut SolveStats,
     ) -> bool;
 
     /// The last attempt was accepted.
     fn accepted(&mut self);
+}
+
+/// An error-controlled integrator: an embedded method `M` under this module's step-size
+/// control. The last accepted step size is carried from one interval to the next, so
+/// consecutive communication steps do not restart from scratch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Adaptive<const N: usize, M> {
+    pub controls: Controls<N>,
+    h_next: f64,
+    method: std::marker::PhantomData<M>,
+}
+
+impl<const N: usize, M: Embedded<N>> Adaptive<N, M> {
+    pub fn new(rtol: f64, abs_scale: [f64; N], max_step: f64, max_steps: u64) -> Self {
+        Adaptive {
+            controls: Controls {
+                rtol,
+                abs_scale,
+                max_step,
+                max_steps,
+            },
+            h_next: 0.0,
+            method: std::marker::PhantomData,
+        }
+    }
+
+    /// The step size carried into the next interval (0: none yet), for saving the state.
+    pub fn carried_step(&self) -> f64 {
+        self.h_next
+    }
+
+    /// Restore a carried step size saved with [`Adaptive::carried_step`].
+    pub fn set_carried_step(&mut self, h: f64) {
+        self.h_next = if h.is_finite() && h > 0.0 { h } else { 0.0 };
+    }
+
+    /// Advance `y` from `t0` to `t1` (> t0) to tolerance. On error `y` and the carried step
+    /// size are left unchanged.
+    pub fn integrate<F: Rhs<N>>(
+        &mut self,
+        f: &F,
+        t0: f64,
+        t1: f64,
+        y: &mut [f64; N],
+    ) -> Result<SolveStats, SolveError> {
+        integrate(
+            &mut M::default(),
+            &self.controls,
+            &mut self.h_next,
+            f,
+            t0,
+            t1,
+            y,
+        )
+    }
 }
 
 /// Starting step from the size of y and y' (Hairer, Norsett & Wanner I, II.4).
@@ -106,7 +162,7 @@ fn initial_step<const N: usize, F: Rhs<N>>(
 
 /// Advance `y` from `t0` to `t1` (> t0) to tolerance with `method`, starting from the carried
 /// step `*h_next` (0: choose). On error `y` and `*h_next` are left unchanged.
-pub(crate) fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
+fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
     method: &mut M,
     ctl: &Controls<N>,
     h_next: &mut f64,
@@ -143,7 +199,7 @@ pub(crate) fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
         let remaining = t1 - t;
         let last = h >= remaining;
         let hs = if last { remaining } else { h };
-        let ok = method.attempt(f, t, &z, hs, &mut y_new, &mut err, &mut stats);
+        let ok = method.attempt(f, t, &z, hs, &mut y_new, &mut err, ctl, &mut stats);
         let e = if ok && all_finite(&y_new) {
             ctl.norm(&err, &z, &y_new)
         } else {

@@ -1,8 +1,8 @@
 //! Dormand-Prince 5(4): explicit embedded Runge-Kutta pair with local error control
 //! (Hairer, Norsett & Wanner, Solving ODEs I, section II.4 and II.5).
 
-use super::adaptive::{self, Controls, Embedded};
-use super::{Rhs, SolveError, SolveStats, all_finite};
+use super::adaptive::{Adaptive, Controls, Embedded};
+use super::{Rhs, SolveStats, all_finite};
 
 // Butcher tableau.
 const C2: f64 = 1.0 / 5.0;
@@ -37,21 +37,26 @@ const E5: f64 = -17253.0 / 339200.0;
 const E6: f64 = 22.0 / 525.0;
 const E7: f64 = -1.0 / 40.0;
 
-/// Adaptive Dormand-Prince 5(4) integrator. The last accepted step size is carried from one
-/// interval to the next, so consecutive communication steps do not restart from scratch.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Dopri5<const N: usize> {
-    pub controls: Controls<N>,
-    h_next: f64,
-}
+/// Adaptive Dormand-Prince 5(4).
+pub type Dopri5<const N: usize> = Adaptive<N, DormandPrince<N>>;
 
-/// The stages of one method instance; k1 is kept between steps (first same as last).
-struct Stages<const N: usize> {
+/// The Dormand-Prince 5(4) pair's stages; k1 is kept between steps (first same as last).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DormandPrince<const N: usize> {
     k1: [f64; N],
     k7: [f64; N],
 }
 
-impl<const N: usize> Embedded<N> for Stages<N> {
+impl<const N: usize> Default for DormandPrince<N> {
+    fn default() -> Self {
+        DormandPrince {
+            k1: [0.0; N],
+            k7: [0.0; N],
+        }
+    }
+}
+
+impl<const N: usize> Embedded<N> for DormandPrince<N> {
     const ORDER: f64 = 5.0;
 
     fn begin<F: Rhs<N>>(&mut self, f: &F, t: f64, y: &[f64; N], f0: &mut [f64; N]) {
@@ -67,6 +72,7 @@ impl<const N: usize> Embedded<N> for Stages<N> {
         hs: f64,
         y_new: &mut [f64; N],
         err: &mut [f64; N],
+        _ctl: &Controls<N>,
         stats: &mut SolveStats,
     ) -> bool {
         let k1 = &self.k1;
@@ -109,45 +115,5 @@ impl<const N: usize> Embedded<N> for Stages<N> {
 
     fn accepted(&mut self) {
         self.k1 = self.k7;
-    }
-}
-
-impl<const N: usize> Dopri5<N> {
-    pub fn new(rtol: f64, abs_scale: [f64; N], max_step: f64, max_steps: u64) -> Self {
-        Dopri5 {
-            controls: Controls {
-                rtol,
-                abs_scale,
-                max_step,
-                max_steps,
-            },
-            h_next: 0.0,
-        }
-    }
-
-    /// The step size carried into the next interval (0: none yet), for saving the state.
-    pub fn carried_step(&self) -> f64 {
-        self.h_next
-    }
-
-    /// Restore a carried step size saved with [`Dopri5::carried_step`].
-    pub fn set_carried_step(&mut self, h: f64) {
-        self.h_next = if h.is_finite() && h > 0.0 { h } else { 0.0 };
-    }
-
-    /// Advance `y` from `t0` to `t1` (> t0) to tolerance. On error `y` and the carried step
-    /// size are left unchanged.
-    pub fn integrate<F: Rhs<N>>(
-        &mut self,
-        f: &F,
-        t0: f64,
-        t1: f64,
-        y: &mut [f64; N],
-    ) -> Result<SolveStats, SolveError> {
-        let mut stages = Stages {
-            k1: [0.0; N],
-            k7: [0.0; N],
-        };
-        adaptive::integrate(&mut stages, &self.controls, &mut self.h_next, f, t0, t1, y)
     }
 }

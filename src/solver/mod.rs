@@ -7,11 +7,11 @@ mod dopri5;
 mod rk4;
 mod sdirk4;
 
-pub use adaptive::Controls;
+pub use adaptive::{Adaptive, Controls, Embedded};
 pub use auto::Auto;
-pub use dopri5::Dopri5;
+pub use dopri5::{Dopri5, DormandPrince};
 pub use rk4::Rk4;
-pub use sdirk4::Sdirk4;
+pub use sdirk4::{Sdirk4, Sdirk4Stages};
 
 /// y' = f(t, y) for a state of fixed size N.
 pub trait Rhs<const N: usize> {

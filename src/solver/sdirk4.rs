@@ -6,8 +6,8 @@
 
 use nalgebra::{Const, DimMin, SMatrix, SVector};
 
-use super::adaptive::{self, Controls, Embedded};
-use super::{Rhs, SolveError, SolveStats};
+use super::adaptive::{Adaptive, Controls, Embedded};
+use super::{Rhs, SolveStats};
 
 const GAMMA: f64 = 0.25;
 const C: [f64; 5] = [0.25, 0.75, 11.0 / 20.0, 0.5, 1.0];
@@ -23,17 +23,14 @@ const B_HAT: [f64; 5] = [59.0 / 48.0, -17.0 / 96.0, 225.0 / 32.0, -85.0 / 12.0, 
 /// Newton iterations per stage before the step is given up and retried smaller.
 const MAX_NEWTON: usize = 8;
 
-#[derive(Clone, Debug, PartialEq)]
-pub struct Sdirk4<const N: usize> {
-    pub controls: Controls<N>,
-    h_next: f64,
-}
+/// Adaptive SDIRK4 with Newton iterations on the system's Jacobian.
+pub type Sdirk4<const N: usize> = Adaptive<N, Sdirk4Stages<N>>;
 
-struct Stages<'a, const N: usize> {
-    controls: &'a Controls<N>,
-}
+/// SDIRK4's stages: nothing is kept between steps.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Sdirk4Stages<const N: usize>;
 
-impl<const N: usize> Embedded<N> for Stages<'_, N>
+impl<const N: usize> Embedded<N> for Sdirk4Stages<N>
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>>,
 {
@@ -51,6 +48,7 @@ where
         h: f64,
         y_new: &mut [f64; N],
         err: &mut [f64; N],
+        ctl: &Controls<N>,
         stats: &mut SolveStats,
     ) -> bool {
         let mut jac = [[0.0; N]; N];
@@ -87,7 +85,7 @@ where
                     z[i] += dz[i];
                 }
                 // Converged well below the step tolerance.
-                if self.controls.norm(&dz_arr, &z, &z) < 1e-3 {
+                if ctl.norm(&dz_arr, &z, &z) < 1e-3 {
                     converged = true;
                     break;
                 }
@@ -119,49 +117,6 @@ where
     }
 
     fn accepted(&mut self) {}
-}
-
-impl<const N: usize> Sdirk4<N>
-where
-    Const<N>: DimMin<Const<N>, Output = Const<N>>,
-{
-    pub fn new(rtol: f64, abs_scale: [f64; N], max_step: f64, max_steps: u64) -> Self {
-        Sdirk4 {
-            controls: Controls {
-                rtol,
-                abs_scale,
-                max_step,
-                max_steps,
-            },
-            h_next: 0.0,
-        }
-    }
-
-    /// The step size carried into the next interval (0: none yet), for saving the state.
-    pub fn carried_step(&self) -> f64 {
-        self.h_next
-    }
-
-    /// Restore a carried step size saved with [`Sdirk4::carried_step`].
-    pub fn set_carried_step(&mut self, h: f64) {
-        self.h_next = if h.is_finite() && h > 0.0 { h } else { 0.0 };
-    }
-
-    /// Advance `y` from `t0` to `t1` (> t0) to tolerance. On error `y` and the carried step
-    /// size are left unchanged.
-    pub fn integrate<F: Rhs<N>>(
-        &mut self,
-        f: &F,
-        t0: f64,
-        t1: f64,
-        y: &mut [f64; N],
-    ) -> Result<SolveStats, SolveError> {
-        let controls = self.controls.clone();
-        let mut stages = Stages {
-            controls: &controls,
-        };
-        adaptive::integrate(&mut stages, &controls, &mut self.h_next, f, t0, t1, y)
-    }
 }
 
 #[cfg(test)]
