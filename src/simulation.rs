@@ -204,9 +204,9 @@ impl std::fmt::Display for StepError {
     }
 }
 
-/// Numbers in [`Simulation::snapshot`] besides the model's state: two carried steps,
+/// Numbers in [`Simulation::snapshot`] besides the model's state: the integrator's memory,
 /// amplitude, mean force (flag and value), amplitude estimator.
-const SNAPSHOT_EXTRA: usize = 5 + TRACKER_STATE;
+const SNAPSHOT_EXTRA: usize = 6 + TRACKER_STATE;
 
 #[derive(Clone, Debug, PartialEq)]
 enum Integrator {
@@ -232,21 +232,21 @@ impl Integrator {
         }
     }
 
-    /// Step sizes carried between intervals (what the configuration does not determine).
-    fn carried_steps(&self) -> [f64; 2] {
+    /// What is carried between intervals (what the configuration does not determine).
+    fn memory(&self) -> [f64; 3] {
         match self {
-            Integrator::DormandPrince(m) => [m.carried_step(), 0.0],
-            Integrator::Sdirk4(m) => [m.carried_step(), 0.0],
-            Integrator::Auto(m) => m.carried_steps(),
-            Integrator::Rk4(_) => [0.0; 2],
+            Integrator::DormandPrince(m) => [m.carried_step(), 0.0, 0.0],
+            Integrator::Sdirk4(m) => [m.carried_step(), 0.0, 0.0],
+            Integrator::Auto(m) => m.memory(),
+            Integrator::Rk4(_) => [0.0; 3],
         }
     }
 
-    fn set_carried_steps(&mut self, h: [f64; 2]) {
+    fn set_memory(&mut self, h: [f64; 3]) {
         match self {
             Integrator::DormandPrince(m) => m.set_carried_step(h[0]),
             Integrator::Sdirk4(m) => m.set_carried_step(h[0]),
-            Integrator::Auto(m) => m.set_carried_steps(h),
+            Integrator::Auto(m) => m.set_memory(h),
             Integrator::Rk4(_) => {}
         }
     }
@@ -434,8 +434,11 @@ impl Simulation {
             tracker = Some(tr);
         }
         let [a1, a2] = inputs.a_derivatives;
+        // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
+        // input, and (t + h) - t is not h in floating point (at t = 3600 s and h = 1 ms, a
+        // relative error of 1e-9 in every step's length).
         let base = BaseAcceleration {
-            t0: t,
+            t0: 0.0,
             a: [inputs.a, a1, a2],
         };
         let limit = 100.0 * self.config.tank.length;
@@ -456,12 +459,12 @@ impl Simulation {
                 let mut next = *y;
                 // The integrators change nothing of themselves when they fail; a runaway found
                 // after a successful integration puts their carried step sizes back.
-                let carried = integrator.carried_steps();
+                let carried = integrator.memory();
                 let stats = integrator
-                    .integrate(&next_model, t, t + h, &mut next)
-                    .map_err(StepError::Solver)?;
+                    .integrate(&next_model, 0.0, h, &mut next)
+                    .map_err(|e| StepError::Solver(e.shifted(t)))?;
                 if next[state::X].abs() > limit {
-                    integrator.set_carried_steps(carried);
+                    integrator.set_memory(carried);
                     return Err(StepError::Runaway {
                         x: next[state::X],
                         limit,
@@ -517,13 +520,13 @@ impl Simulation {
         let carried = match &self.dynamics {
             Dynamics::Nonlinear { integrator, y, .. } => {
                 out.extend_from_slice(y);
-                integrator.carried_steps()
+                integrator.memory()
             }
             Dynamics::Linear { modes } => {
                 for (_, _, s) in modes {
                     out.extend_from_slice(&[s.x, s.v, s.work_in, s.dissipated]);
                 }
-                [0.0; 2]
+                [0.0; 3]
             }
         };
         out.extend_from_slice(&carried);
@@ -557,7 +560,7 @@ impl Simulation {
         match &mut sim.dynamics {
             Dynamics::Nonlinear { integrator, y, .. } => {
                 y.copy_from_slice(model_state);
-                integrator.set_carried_steps([rest[0], rest[1]]);
+                integrator.set_memory([rest[0], rest[1], rest[2]]);
             }
             Dynamics::Linear { modes } => {
                 for ((_, _, s), v) in modes.iter_mut().zip(model_state.chunks_exact(4)) {
@@ -570,7 +573,7 @@ impl Simulation {
                 }
             }
         }
-        let rest = &rest[2..];
+        let rest = &rest[3..];
         sim.amplitude = rest[0];
         sim.last_mean_force = match rest[1] {
             0.0 => None,

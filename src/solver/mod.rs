@@ -57,6 +57,17 @@ pub enum SolveError {
     NonFinite { t: f64 },
 }
 
+impl SolveError {
+    /// The same error with its time moved by `t0` (an interval integrated in its own time).
+    pub fn shifted(self, t0: f64) -> Self {
+        match self {
+            SolveError::TooManySteps { limit, t } => SolveError::TooManySteps { limit, t: t + t0 },
+            SolveError::StepTooSmall { h, t } => SolveError::StepTooSmall { h, t: t + t0 },
+            SolveError::NonFinite { t } => SolveError::NonFinite { t: t + t0 },
+        }
+    }
+}
+
 impl std::fmt::Display for SolveError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -177,6 +188,36 @@ mod tests {
             matches!(r, Err(SolveError::TooManySteps { .. })),
             "explicit needs > 1e5 steps: {r:?}"
         );
+    }
+
+    #[test]
+    fn auto_goes_implicit_only_where_the_problem_is_stiff() {
+        struct Stiff;
+        impl Rhs<1> for Stiff {
+            fn eval(&self, t: f64, y: &[f64; 1], dy: &mut [f64; 1]) {
+                dy[0] = -1e6 * (y[0] - t.cos());
+            }
+        }
+        let mut auto = Auto::new(1e-8, [1.0], f64::INFINITY, 1_000_000);
+        let mut y = [1.0];
+        for k in 0..20 {
+            auto.integrate(&Stiff, k as f64 * 0.1, (k + 1) as f64 * 0.1, &mut y)
+                .expect("stiff");
+        }
+        assert!((y[0] - 2f64.cos()).abs() < 1e-5);
+        assert!(auto.implicit_intervals >= 19, "{}", auto.implicit_intervals);
+        // A lightly damped oscillator is not stiff, even over quarter-period intervals at a loose
+        // tolerance (where an explicit step can reach h |lambda| ~ 3).
+        let w = 5.6389;
+        let mut auto = Auto::new(1e-6, [1.0, w], f64::INFINITY, 1_000_000);
+        let mut y = [1.0, 0.0];
+        let h = 0.25 * std::f64::consts::TAU / w;
+        for k in 0..400 {
+            auto.integrate(&Oscillator(w), k as f64 * h, (k + 1) as f64 * h, &mut y)
+                .expect("oscillator");
+        }
+        assert_eq!(auto.implicit_intervals, 0);
+        assert!(error_after(&y, w, 400.0 * h) < 1e-3);
     }
 
     #[test]
