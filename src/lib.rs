@@ -4,6 +4,7 @@
 //! configured damper stepping over communication intervals) -> `physics` (the equations of the
 //! seed, corrected) and `solver` (integrators generic over a right-hand side).
 
+pub mod analysis;
 pub mod fmi;
 pub mod physics;
 pub mod simulation;

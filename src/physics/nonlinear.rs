@@ -63,6 +63,16 @@ impl PowerLaw {
         }
     }
 
+    /// omega_f^2, the linear stiffness per unit mass.
+    pub fn linear_stiffness(&self) -> f64 {
+        self.omega2
+    }
+
+    /// The exponent eta of Eq 2.13.
+    pub fn eta(&self) -> f64 {
+        self.eta
+    }
+
     /// phi |xi|^(2 eta - 2): the hardening of the stiffness relative to the linear one.
     #[inline]
     pub fn hardening(&self, x: f64) -> f64 {

@@ -47,7 +47,9 @@ pub fn library_path() -> PathBuf {
         .and_then(|m| m.modified())
         .unwrap_or_else(|_| panic!("{} is not built: run `cargo build` first", path.display()));
     // `cargo test` does not rebuild the cdylib: refuse to test a library older than its sources.
-    let newest = newest_source(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src"));
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let newest =
+        newest_source(&root.join("src")).max(newest_source(&root.join("modelDescription")));
     assert!(
         built >= newest,
         "{} is older than the sources: run `cargo build` first",
@@ -60,6 +62,10 @@ fn newest_source(dir: &std::path::Path) -> std::time::SystemTime {
     let mut newest = std::time::SystemTime::UNIX_EPOCH;
     for entry in std::fs::read_dir(dir).into_iter().flatten().flatten() {
         let p = entry.path();
+        // The command-line tools in src/bin are not part of the library.
+        if p.ends_with("bin") {
+            continue;
+        }
         let t = if p.is_dir() {
             newest_source(&p)
         } else {
