@@ -6,7 +6,7 @@ use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::physics::linear::{Mode, ModeState};
 use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, state};
-use crate::solver::{Auto, Dopri5, Rk4, Sdirk4, SolveError, SolveStats};
+use crate::solver::{Auto, Dop853, Dopri5, Rk4, Sdirk4, SolveError, SolveStats};
 
 /// Where the excitation amplitude of the amplitude laws comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,6 +36,8 @@ pub enum Method {
 pub enum AdaptiveKind {
     /// Explicit Dormand-Prince 5(4).
     DormandPrince,
+    /// Explicit Dormand-Prince 8(5,3), for tight tolerances.
+    DormandPrince853,
     /// L-stable implicit SDIRK4.
     Sdirk4,
     /// Per interval, whichever of the two the local stiffness calls for.
@@ -211,6 +213,7 @@ const SNAPSHOT_EXTRA: usize = 6 + TRACKER_STATE;
 #[derive(Clone, Debug, PartialEq)]
 enum Integrator {
     DormandPrince(Dopri5<{ state::DIM }>),
+    DormandPrince853(Dop853<{ state::DIM }>),
     Sdirk4(Sdirk4<{ state::DIM }>),
     Auto(Auto<{ state::DIM }>),
     Rk4(Rk4),
@@ -226,6 +229,7 @@ impl Integrator {
     ) -> Result<SolveStats, SolveError> {
         match self {
             Integrator::DormandPrince(m) => m.integrate(model, t0, t1, y),
+            Integrator::DormandPrince853(m) => m.integrate(model, t0, t1, y),
             Integrator::Sdirk4(m) => m.integrate(model, t0, t1, y),
             Integrator::Auto(m) => m.integrate(model, t0, t1, y),
             Integrator::Rk4(m) => m.integrate(model, t0, t1, y),
@@ -236,6 +240,7 @@ impl Integrator {
     fn memory(&self) -> [f64; 3] {
         match self {
             Integrator::DormandPrince(m) => [m.carried_step(), 0.0, 0.0],
+            Integrator::DormandPrince853(m) => [m.carried_step(), 0.0, 0.0],
             Integrator::Sdirk4(m) => [m.carried_step(), 0.0, 0.0],
             Integrator::Auto(m) => m.memory(),
             Integrator::Rk4(_) => [0.0; 3],
@@ -245,6 +250,7 @@ impl Integrator {
     fn set_memory(&mut self, h: [f64; 3]) {
         match self {
             Integrator::DormandPrince(m) => m.set_carried_step(h[0]),
+            Integrator::DormandPrince853(m) => m.set_carried_step(h[0]),
             Integrator::Sdirk4(m) => m.set_carried_step(h[0]),
             Integrator::Auto(m) => m.set_memory(h),
             Integrator::Rk4(_) => {}
@@ -396,6 +402,9 @@ impl Simulation {
                 };
                 let n = config.max_substeps;
                 match kind {
+                    AdaptiveKind::DormandPrince853 => {
+                        Integrator::DormandPrince853(Dop853::new(rtol, scale, max_step, n))
+                    }
                     AdaptiveKind::DormandPrince => {
                         Integrator::DormandPrince(Dopri5::new(rtol, scale, max_step, n))
                     }

@@ -112,6 +112,7 @@ impl Values {
             },
             3 => adaptive(AdaptiveKind::Sdirk4),
             4 => adaptive(AdaptiveKind::Auto),
+            5 => adaptive(AdaptiveKind::DormandPrince853),
             _ => adaptive(AdaptiveKind::DormandPrince),
         };
         let model = if g(vr::MODEL) == 1.0 {

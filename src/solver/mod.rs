@@ -3,12 +3,14 @@
 
 mod adaptive;
 mod auto;
+mod dop853;
 mod dopri5;
 mod rk4;
 mod sdirk4;
 
 pub use adaptive::{Adaptive, Controls, Embedded};
 pub use auto::Auto;
+pub use dop853::{Dop853, Dop853Stages};
 pub use dopri5::{Dopri5, DormandPrince};
 pub use rk4::Rk4;
 pub use sdirk4::{Sdirk4, Sdirk4Stages};
@@ -218,6 +220,30 @@ mod tests {
         }
         assert_eq!(auto.implicit_intervals, 0);
         assert!(error_after(&y, w, 400.0 * h) < 1e-3);
+    }
+
+    #[test]
+    fn dop853_meets_its_tolerance_and_is_eighth_order() {
+        let w = 5.6389;
+        for rtol in [1e-8, 1e-11, 1e-13] {
+            let mut m = Dop853::new(rtol, [1.0, w], f64::INFINITY, 100_000);
+            let mut y = [1.0, 0.0];
+            for k in 0..100 {
+                m.integrate(&Oscillator(w), k as f64 * 0.1, (k + 1) as f64 * 0.1, &mut y)
+                    .expect("step");
+            }
+            let e = error_after(&y, w, 10.0);
+            assert!(e < 100.0 * rtol, "rtol {rtol}: error {e}");
+        }
+        // Fixed steps: error ratio 2^8 on halving.
+        let run = |h: f64| {
+            let mut m = Dop853::new(1.0, [1e9, 1e9], h, 1_000_000);
+            let mut y = [1.0, 0.0];
+            m.integrate(&Oscillator(w), 0.0, 4.0, &mut y).expect("run");
+            error_after(&y, w, 4.0)
+        };
+        let ratio = run(0.2) / run(0.1);
+        assert!((ratio / 256.0 - 1.0).abs() < 0.25, "error ratio {ratio}");
     }
 
     #[test]

@@ -178,3 +178,16 @@ def test_late_start_time_does_not_cost_accuracy(slave_factory):
     err = R.rel_err(out["slosh.x"], R.simulate_held(p, dt, a).x)
     print(f"start 1e5 s: error {err:.2e}")
     assert err < 1e-9
+
+
+def test_dop853_against_the_reference(slave_factory):
+    # DormandPrince853 (solver 5) at a tight tolerance and long communication steps, where it
+    # is meant to pay: the eta = 2 harmonic scene at 50 ms, solver.tolerance 1e-13.
+    p = R.TLD(eta=2.0, damping=R.DAMPING_CONSTANT, zeta=0.02)
+    dt, n = 0.05, 1200
+    _, _, a = R.harmonic_base(p.omega_f, 0.005, dt * np.arange(n))
+    out = fmu_run(slave_factory, p, dt, n, {"base.a": a}, extra={"solver": 5, "solver.tolerance": 1e-13})
+    ref = R.simulate_held(p, dt, a, substeps=50)
+    err = R.rel_err(out["slosh.x"], ref.x)
+    print(f"DOP853 at 50 ms, rtol 1e-13: error {err:.2e}")
+    assert err < 1e-10
