@@ -6,3 +6,4 @@ pub mod geometry;
 pub mod laws;
 pub mod linear;
 pub mod nonlinear;
+pub mod slamming;
