@@ -3,9 +3,11 @@
 
 use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
 use crate::physics::geometry::Tank;
+use crate::physics::laws::nsd_kappa;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::physics::linear::{Mode, ModeState};
 use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, state};
+use crate::physics::slamming::{SlamState, Slamming};
 use crate::solver::{Auto, Dop853, Dopri5, Rk4, Sdirk4, SolveError, SolveStats};
 
 /// Where the excitation amplitude of the amplitude laws comes from.
@@ -48,12 +50,27 @@ pub enum AdaptiveKind {
 pub const MAX_MODES: u32 = 50;
 
 /// Which model of the seed's ladder the damper runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ModelKind {
     /// `modes` linear sloshing modes (Eqs 2.1, 2.2), advanced exactly.
     Linear { modes: u32 },
     /// The impact-characteristic model (Eq 2.11 with Eq 2.13).
     Nonlinear,
+    /// Sloshing-slamming (S^2, Eqs 2.5-2.8): the fundamental mode with mass Omega m_1 on its
+    /// unchanged spring (frequency omega_1 / sqrt(Omega)) and an impact mass
+    /// (mass_ratio + 1 - Omega) m_1 slamming on the walls across the clearance.
+    SloshingSlamming(SlammingParams),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlammingParams {
+    /// Mass exchange Omega in (0, 1]; 0: from the NSD hardening law, Omega = 1/kappa(Lambda)^2.
+    pub omega: f64,
+    pub restitution: f64,
+    /// d [m].
+    pub clearance: f64,
+    /// Impact mass before the exchange over m_1 (the seed: 0.01).
+    pub mass_ratio: f64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,17 +106,31 @@ impl Config {
     fn mode_count(&self) -> u32 {
         match self.model {
             ModelKind::Linear { modes } => modes.max(1),
-            ModelKind::Nonlinear => 1,
+            ModelKind::Nonlinear | ModelKind::SloshingSlamming(_) => 1,
         }
+    }
+
+    /// The S^2 mass exchange Omega in use.
+    fn mass_exchange(&self, params: &SlammingParams, amplitude: f64) -> f64 {
+        if params.omega > 0.0 {
+            return params.omega.min(1.0);
+        }
+        let kappa = nsd_kappa(self.lambda.clamp(amplitude / self.tank.length));
+        (1.0 / (kappa * kappa)).clamp(1e-3, 1.0)
     }
 
     pub fn derived(&self) -> Derived {
         let n = f64::from(self.tanks);
         let liquid = self.tank.liquid_mass() * n;
-        let slosh = (1..=self.mode_count())
+        let modes = (1..=self.mode_count())
             .map(|k| self.tank.mode(k).mass)
-            .sum::<f64>()
-            * n;
+            .sum::<f64>();
+        // S^2: the impact mass before the exchange comes out of the liquid at rest.
+        let extra = match self.model {
+            ModelKind::SloshingSlamming(p) => p.mass_ratio * self.tank.fundamental().mass,
+            _ => 0.0,
+        };
+        let slosh = (modes + extra) * n;
         Derived {
             omega_f: self.tank.fundamental().omega,
             mass_liquid: liquid,
@@ -142,6 +173,20 @@ impl Config {
                 "modes = {modes}: the linear model carries 1 to {MAX_MODES} modes"
             ));
         }
+        if let ModelKind::SloshingSlamming(p) = self.model {
+            if p.clearance > self.tank.length {
+                return Err(format!(
+                    "slamming.clearance ({} m) exceeds the tank length ({} m)",
+                    p.clearance, self.tank.length
+                ));
+            }
+            if self.derived().mass_inactive < 0.0 {
+                return Err(format!(
+                    "slamming.mass_ratio ({}) takes more liquid than the tank holds",
+                    p.mass_ratio
+                ));
+            }
+        }
         if self.x0.abs() > self.tank.length {
             return Err(format!(
                 "|slosh.x0| = {} m exceeds the tank length {} m",
@@ -183,6 +228,9 @@ pub enum Output {
     Amplitude,
     /// Damping ratio in use.
     Zeta,
+    /// S^2: position of the impact mass relative to the tank centre [m], and impacts so far.
+    ImpactZ,
+    Impacts,
 }
 
 /// Why a communication step was refused. The simulation is left as it was before the step.
@@ -192,6 +240,8 @@ pub enum StepError {
     Solver(SolveError),
     /// The sloshing displacement left any physical range: the model is meaningless there.
     Runaway { x: f64, limit: f64 },
+    /// S^2 impacts did not come to rest within the step's bound.
+    Chattering(String),
 }
 
 impl std::fmt::Display for StepError {
@@ -202,6 +252,7 @@ impl std::fmt::Display for StepError {
                 f,
                 "the sloshing displacement ran away to {x:e} m (limit {limit} m, 100 tank lengths)"
             ),
+            StepError::Chattering(why) => write!(f, "{why}"),
         }
     }
 }
@@ -272,6 +323,11 @@ enum Dynamics {
     },
     /// Each mode with its total modal mass and state; the first is the fundamental.
     Linear { modes: Vec<(Mode, f64, ModeState)> },
+    /// S^2: the sloshing mode (mode, mass, state) and the impact mass (law, mass, state).
+    Slamming {
+        mode: (Mode, f64, ModeState),
+        impact: (Slamming, f64, SlamState),
+    },
 }
 
 impl Dynamics {
@@ -280,6 +336,7 @@ impl Dynamics {
         match self {
             Dynamics::Nonlinear { .. } => state::DIM,
             Dynamics::Linear { modes } => 4 * modes.len(),
+            Dynamics::Slamming { .. } => 4 + 6,
         }
     }
 }
@@ -336,6 +393,35 @@ impl Simulation {
                         model,
                         integrator: Self::integrator(&config, omega_f),
                         y,
+                    },
+                    energy,
+                )
+            }
+            ModelKind::SloshingSlamming(p) => {
+                let m1 = config.tank.fundamental();
+                let omega = config.mass_exchange(&p, amplitude);
+                let mode = Mode {
+                    omega: m1.omega / omega.sqrt(),
+                    zeta,
+                };
+                let sloshing = omega * m1.mass * tanks;
+                let state = ModeState {
+                    x: config.x0,
+                    v: config.v0,
+                    ..ModeState::default()
+                };
+                let slam = Slamming {
+                    clearance: p.clearance,
+                    restitution: p.restitution,
+                    // A rebound slower than 1e-6 of the clearance crossed per sloshing period.
+                    rest_speed: 1e-6 * p.clearance * m1.omega,
+                };
+                let impact_mass = (p.mass_ratio + 1.0 - omega) * m1.mass * tanks;
+                let energy = sloshing * mode.stored_energy(&state);
+                (
+                    Dynamics::Slamming {
+                        mode: (mode, sloshing, state),
+                        impact: (slam, impact_mass, SlamState::default()),
                     },
                     energy,
                 )
@@ -512,6 +598,33 @@ impl Simulation {
                     impulse,
                 )
             }
+            Dynamics::Slamming { mode, impact } => {
+                let mut sloshing = *mode;
+                sloshing.0.zeta = zeta;
+                sloshing.0.advance(&mut sloshing.2, h, &base);
+                if sloshing.2.x.is_nan() || sloshing.2.x.abs() > limit {
+                    return Err(StepError::Runaway {
+                        x: sloshing.2.x,
+                        limit,
+                    });
+                }
+                let mut slam = impact.2;
+                let per_mass = impact
+                    .0
+                    .advance(&mut slam, h, &base)
+                    .map_err(StepError::Chattering)?;
+                let impulse = sloshing.1 * (-(sloshing.2.v - mode.2.v) - base.integral(h))
+                    + impact.1 * per_mass;
+                *mode = sloshing;
+                impact.2 = slam;
+                (
+                    SolveStats {
+                        accepted: 1,
+                        ..SolveStats::default()
+                    },
+                    impulse,
+                )
+            }
         };
         self.last_mean_force = Some(impulse / h);
         self.zeta = zeta;
@@ -535,6 +648,21 @@ impl Simulation {
                 for (_, _, s) in modes {
                     out.extend_from_slice(&[s.x, s.v, s.work_in, s.dissipated]);
                 }
+                [0.0; 3]
+            }
+            Dynamics::Slamming {
+                mode: (_, _, s),
+                impact: (_, _, i),
+            } => {
+                out.extend_from_slice(&[s.x, s.v, s.work_in, s.dissipated]);
+                out.extend_from_slice(&[
+                    i.z,
+                    i.v,
+                    f64::from(i.contact),
+                    i.impacts as f64,
+                    i.work_in,
+                    i.dissipated,
+                ]);
                 [0.0; 3]
             }
         };
@@ -581,6 +709,32 @@ impl Simulation {
                     };
                 }
             }
+            Dynamics::Slamming { mode, impact } => {
+                let (m, i) = model_state.split_at(4);
+                mode.2 = ModeState {
+                    x: m[0],
+                    v: m[1],
+                    work_in: m[2],
+                    dissipated: m[3],
+                };
+                let contact = match i[2] {
+                    0.0 => 0,
+                    1.0 => 1,
+                    -1.0 => -1,
+                    _ => return Err("the state's wall-contact flag is not -1, 0 or 1".into()),
+                };
+                if i[0].abs() > 0.5 * impact.0.clearance || i[3] < 0.0 || i[3].fract() != 0.0 {
+                    return Err("the impact mass's state is out of range".into());
+                }
+                impact.2 = SlamState {
+                    z: i[0],
+                    v: i[1],
+                    contact,
+                    impacts: i[3] as u64,
+                    work_in: i[4],
+                    dissipated: i[5],
+                };
+            }
         }
         let rest = &rest[3..];
         sim.amplitude = rest[0];
@@ -598,65 +752,82 @@ impl Simulation {
         Ok(sim)
     }
 
-    /// The output `which` now.
-    pub fn output(&self, which: Output, inputs: &Inputs) -> f64 {
-        match (which, &self.dynamics) {
-            (Output::ForceMean, _) => self
-                .last_mean_force
-                .unwrap_or_else(|| self.output(Output::Force, inputs)),
-            (Output::BaseShear, _) => {
-                self.output(Output::Force, inputs) - self.derived.mass_inactive * inputs.a
-            }
-            (Output::EnergyInput, _) => {
-                self.initial_energy
-                    + self.sum(|_, m, s| m * s.work_in, |m, y| m * y[state::WORK_IN])
-            }
-            (Output::EnergyDissipated, _) => {
-                self.sum(|_, m, s| m * s.dissipated, |m, y| m * y[state::DISSIPATED])
-            }
-            (Output::EnergyStored, Dynamics::Nonlinear { model, y, .. }) => {
-                self.derived.mass_slosh * model.stored_energy(y[state::X], y[state::V])
-            }
-            (Output::EnergyStored, Dynamics::Linear { modes }) => modes
-                .iter()
-                .map(|(mode, m, s)| m * mode.stored_energy(s))
-                .sum(),
-            (Output::Force, Dynamics::Nonlinear { model, y, .. }) => {
-                self.derived.mass_slosh * model.tank_force(y[state::X], y[state::V])
-            }
-            (Output::Force, Dynamics::Linear { modes }) => modes
-                .iter()
-                .map(|(mode, m, s)| m * mode.tank_force(s))
-                .sum(),
-            (Output::X, Dynamics::Nonlinear { y, .. }) => y[state::X],
-            (Output::X, Dynamics::Linear { modes }) => modes[0].2.x,
-            (Output::V, Dynamics::Nonlinear { y, .. }) => y[state::V],
-            (Output::V, Dynamics::Linear { modes }) => modes[0].2.v,
-            (Output::Amplitude, _) => self.amplitude,
-            (Output::Zeta, _) => self.zeta,
+    /// The linear modes: all of them (Linear), the sloshing mode (SloshingSlamming).
+    fn linear_modes(&self) -> &[(Mode, f64, ModeState)] {
+        match &self.dynamics {
+            Dynamics::Linear { modes } => modes,
+            Dynamics::Slamming { mode, .. } => std::slice::from_ref(mode),
+            Dynamics::Nonlinear { .. } => &[],
         }
     }
 
-    /// A sum over the modes of the linear model, or the nonlinear model's state.
-    fn sum(
-        &self,
-        linear: impl Fn(&Mode, f64, &ModeState) -> f64,
-        nonlinear: impl Fn(f64, &[f64; state::DIM]) -> f64,
-    ) -> f64 {
+    /// The impact mass of the S^2 model: its mass and state.
+    fn impact(&self) -> Option<(f64, &SlamState)> {
         match &self.dynamics {
-            Dynamics::Nonlinear { y, .. } => nonlinear(self.derived.mass_slosh, y),
-            Dynamics::Linear { modes } => {
-                modes.iter().map(|(mode, m, s)| linear(mode, *m, s)).sum()
+            Dynamics::Slamming { impact, .. } => Some((impact.1, &impact.2)),
+            _ => None,
+        }
+    }
+
+    /// The output `which` now.
+    pub fn output(&self, which: Output, inputs: &Inputs) -> f64 {
+        let modes = self.linear_modes();
+        let impact = self.impact();
+        let over_modes = |f: &dyn Fn(&Mode, &ModeState) -> f64| {
+            modes.iter().map(|(mode, m, s)| m * f(mode, s)).sum::<f64>()
+        };
+        let over_impact = |f: &dyn Fn(&SlamState) -> f64| impact.map_or(0.0, |(m, s)| m * f(s));
+        let nonlinear = match &self.dynamics {
+            Dynamics::Nonlinear { model, y, .. } => Some((model, y)),
+            _ => None,
+        };
+        let m = self.derived.mass_slosh;
+        match which {
+            Output::ForceMean => self
+                .last_mean_force
+                .unwrap_or_else(|| self.output(Output::Force, inputs)),
+            // The impact mass resting on a wall moves with the tank, like the inactive liquid.
+            Output::BaseShear => {
+                self.output(Output::Force, inputs)
+                    - self.derived.mass_inactive * inputs.a
+                    - over_impact(&|s| if s.contact != 0 { inputs.a } else { 0.0 })
             }
+            Output::Force => match nonlinear {
+                Some((model, y)) => m * model.tank_force(y[state::X], y[state::V]),
+                None => over_modes(&|mode, s| mode.tank_force(s)),
+            },
+            Output::X => nonlinear.map_or_else(|| modes[0].2.x, |(_, y)| y[state::X]),
+            Output::V => nonlinear.map_or_else(|| modes[0].2.v, |(_, y)| y[state::V]),
+            Output::EnergyInput => {
+                self.initial_energy
+                    + nonlinear.map_or(0.0, |(_, y)| m * y[state::WORK_IN])
+                    + over_modes(&|_, s| s.work_in)
+                    + over_impact(&|s| s.work_in)
+            }
+            Output::EnergyDissipated => {
+                nonlinear.map_or(0.0, |(_, y)| m * y[state::DISSIPATED])
+                    + over_modes(&|_, s| s.dissipated)
+                    + over_impact(&|s| s.dissipated)
+            }
+            Output::EnergyStored => {
+                nonlinear.map_or(0.0, |(model, y)| {
+                    m * model.stored_energy(y[state::X], y[state::V])
+                }) + over_modes(&|mode, s| mode.stored_energy(s))
+                    + over_impact(&|s| 0.5 * s.v * s.v)
+            }
+            Output::Amplitude => self.amplitude,
+            Output::Zeta => self.zeta,
+            Output::ImpactZ => impact.map_or(0.0, |(_, s)| s.z),
+            Output::Impacts => impact.map_or(0.0, |(_, s)| s.impacts as f64),
         }
     }
 
     /// The exact first time derivative of the output `which` now (0 for quantities constant
-    /// between communication points).
+    /// between communication points; the impacts themselves are instants, not rates).
     pub fn output_derivative(&self, which: Output, inputs: &Inputs) -> f64 {
         let a = inputs.a;
-        // Per mode (or the nonlinear model): mass, x, v, damping c, stiffness k(x) x and slope.
-        let terms: Vec<(f64, f64, f64, f64, f64, f64)> = match &self.dynamics {
+        // Per oscillator: mass, x, v, damping c, restoring force per mass and its slope.
+        let mut terms: Vec<(f64, f64, f64, f64, f64, f64)> = match &self.dynamics {
             Dynamics::Nonlinear { model, y, .. } => {
                 let (x, v) = (y[state::X], y[state::V]);
                 vec![(
@@ -668,7 +839,8 @@ impl Simulation {
                     model.stiffness.slope(x),
                 )]
             }
-            Dynamics::Linear { modes } => modes
+            _ => self
+                .linear_modes()
                 .iter()
                 .map(|(mode, m, s)| {
                     let w2 = mode.omega * mode.omega;
@@ -677,21 +849,30 @@ impl Simulation {
                 .collect(),
         };
         let acc = |&(_, _, v, c, f, _): &(f64, f64, f64, f64, f64, f64)| -a - c * v - f;
-        let force = || {
-            terms
-                .iter()
-                .map(|t| t.0 * (t.3 * acc(t) + t.5 * t.2))
-                .sum::<f64>()
-        };
+        let force: f64 = terms.iter().map(|t| t.0 * (t.3 * acc(t) + t.5 * t.2)).sum();
+        let (x, v) = (terms[0].2, acc(&terms[0]));
+        // The impact mass in flight: a free mass (no spring, no damper); at rest, still.
+        let in_flight = self.impact().filter(|(_, s)| s.contact == 0);
+        terms.extend(in_flight.map(|(m, s)| (m, s.z, s.v, 0.0, 0.0, 0.0)));
         match which {
-            Output::Force => force(),
-            Output::BaseShear => force() - self.derived.mass_inactive * inputs.a_derivatives[0],
-            Output::X => terms[0].2,
-            Output::V => acc(&terms[0]),
+            Output::Force => force,
+            Output::BaseShear => {
+                let resting = self
+                    .impact()
+                    .filter(|(_, s)| s.contact != 0)
+                    .map_or(0.0, |(m, _)| m);
+                force - (self.derived.mass_inactive + resting) * inputs.a_derivatives[0]
+            }
+            Output::X => x,
+            Output::V => v,
             Output::EnergyInput => terms.iter().map(|t| -t.0 * a * t.2).sum(),
             Output::EnergyDissipated => terms.iter().map(|t| t.0 * t.3 * t.2 * t.2).sum(),
             Output::EnergyStored => terms.iter().map(|t| t.0 * t.2 * (acc(t) + t.4)).sum(),
-            Output::ForceMean | Output::Amplitude | Output::Zeta => 0.0,
+            Output::ForceMean
+            | Output::Amplitude
+            | Output::Zeta
+            | Output::ImpactZ
+            | Output::Impacts => 0.0,
         }
     }
 }

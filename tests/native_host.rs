@@ -406,9 +406,9 @@ fn out_of_range_and_inconsistent_parameters() {
         "not an enumeration item"
     );
     assert_eq!(
-        inst.set_integer(vr::MODEL, 3),
+        inst.set_integer(vr::MODEL, 4),
         ERROR,
-        "SloshingSlamming is not offered yet"
+        "not an item of ModelKind"
     );
     assert_eq!(inst.set_integer(vr::MODES, 51), ERROR, "at most 50 modes");
     assert_eq!(inst.set_integer(vr::TANKS, 0), ERROR);
@@ -433,6 +433,16 @@ fn out_of_range_and_inconsistent_parameters() {
         inst.logs()
     );
     assert_eq!(inst.set_real(vr::LAMBDA_MAX, 0.1), OK);
+    // S^2 with a clearance wider than the tank: refused at exit too.
+    assert_eq!(inst.set_integer(vr::MODEL, 3), OK);
+    assert_eq!(inst.set_real(vr::SLAMMING_CLEARANCE, 0.3), OK);
+    assert_eq!(inst.exit(), ERROR);
+    assert!(
+        inst.logs().iter().any(|m| m.contains("slamming.clearance")),
+        "{:?}",
+        inst.logs()
+    );
+    assert_eq!(inst.set_real(vr::SLAMMING_CLEARANCE, 0.1), OK);
     assert_eq!(inst.exit(), OK);
 }
 
@@ -904,4 +914,53 @@ fn input_derivatives_last_one_step() {
     // The second step sees the same held input in both runs: its velocity change differs only
     // through the slightly different state, not by another 2.5e-3 or more.
     assert!((dv_held - dv_ramp).abs() < 5e-4, "{dv_held} {dv_ramp}");
+}
+
+/// The S^2 model's state (impact mass position, velocity, wall contact, count) survives a
+/// serialised round trip into another instance, bit for bit.
+#[test]
+fn slamming_state_round_trip() {
+    let start = |name: &str| {
+        let inst = Instance::new(name);
+        assert_eq!(inst.setup(), OK);
+        assert_eq!(inst.enter(), OK);
+        assert_eq!(inst.set_integer(vr::MODEL, 3), OK);
+        assert_eq!(inst.set_real(vr::SLAMMING_OMEGA, 0.9), OK);
+        assert_eq!(inst.exit(), OK);
+        inst
+    };
+    let mut a = start("s2-source");
+    a.run_harmonic(300, 0.01);
+    let s = get_state(&a);
+    let bytes = serialize(&a, s);
+    let t_saved = a.time;
+    let uninterrupted = a.run_harmonic(300, 0.01);
+    let impacts = |i: &Instance| {
+        let mut n = 0;
+        unsafe { i.lib.fmi2GetInteger(i.c, &vr::IMPACTS, 1, &mut n) };
+        n
+    };
+    let n_a = impacts(&a);
+    assert!(n_a >= 1, "the scene must slam: {n_a} impacts");
+    let mut b = start("s2-target");
+    let (status, restored) = deserialize(&b, &bytes);
+    assert_eq!(status, OK, "{:?}", b.logs());
+    assert_eq!(
+        unsafe { b.lib.fmi2SetFMUstate(b.c, restored) },
+        OK,
+        "{:?}",
+        b.logs()
+    );
+    b.time = t_saved;
+    assert_eq!(b.run_harmonic(300, 0.01).to_bits(), uninterrupted.to_bits());
+    assert_eq!(impacts(&b), n_a);
+    assert_eq!(
+        b.get_real(vr::IMPACT_Z).1.to_bits(),
+        a.get_real(vr::IMPACT_Z).1.to_bits()
+    );
+    unsafe {
+        let (mut s, mut r) = (s, restored);
+        a.lib.fmi2FreeFMUstate(a.c, &mut s);
+        b.lib.fmi2FreeFMUstate(b.c, &mut r);
+    }
 }

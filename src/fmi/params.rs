@@ -6,6 +6,7 @@ use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::simulation::{
     AdaptiveKind, AmplitudeSource, Config, Derived, Inputs, Method, ModelKind, Output,
+    SlammingParams,
 };
 
 /// Values of all variables, in the order of `VARIABLES` (integers and enumerations as f64).
@@ -115,12 +116,17 @@ impl Values {
             5 => adaptive(AdaptiveKind::DormandPrince853),
             _ => adaptive(AdaptiveKind::DormandPrince),
         };
-        let model = if g(vr::MODEL) == 1.0 {
-            ModelKind::Linear {
+        let model = match g(vr::MODEL) as i64 {
+            1 => ModelKind::Linear {
                 modes: g(vr::MODES) as u32,
-            }
-        } else {
-            ModelKind::Nonlinear
+            },
+            3 => ModelKind::SloshingSlamming(SlammingParams {
+                omega: g(vr::SLAMMING_OMEGA),
+                restitution: g(vr::SLAMMING_RESTITUTION),
+                clearance: g(vr::SLAMMING_CLEARANCE),
+                mass_ratio: g(vr::SLAMMING_MASS_RATIO),
+            }),
+            _ => ModelKind::Nonlinear,
         };
         Config {
             model,
@@ -172,6 +178,8 @@ pub fn output_of(vr: u32) -> Option<Output> {
         vr::ENERGY_STORED => Output::EnergyStored,
         vr::A_E_ESTIMATE => Output::Amplitude,
         vr::ZETA_EFFECTIVE => Output::Zeta,
+        vr::IMPACT_Z => Output::ImpactZ,
+        vr::IMPACTS => Output::Impacts,
         _ => return None,
     })
 }

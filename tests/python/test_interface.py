@@ -71,9 +71,8 @@ def test_enumeration_values(model_description, variables):
         assert int(v.start) == items[ENUM_DEFAULTS[name]], f"{name} default {v.start}"
 
 
-@pytest.mark.xfail(strict=True, reason="FMU.md lists `modes` (Linear model) and the enumeration "
-                   "items Linear/SloshingSlamming; modelDescription 0.1.0 does not declare them yet")
-def test_fmu_md_items_not_yet_declared(variables):
+def test_fmu_md_model_ladder_is_declared(variables):
+    """FMU.md: `modes` and the items Linear, Nonlinear, SloshingSlamming of `model`."""
     assert "modes" in variables
     assert {it.name for it in variables["model"].declaredType.items} >= {
         "Linear", "Nonlinear", "SloshingSlamming"}
