@@ -4,7 +4,14 @@
 //!
 //! tld-freqresp [--length 0.25] [--depth 0.021] [--g 9.81] [--eta 2] [--phi 1] [--zeta 0.02]
 //!              [--A 0.003] [--from 0.8] [--to 1.4] [--points 121] [--csv FILE] [--json]
+//!
+//! With --coupled: the linear response |X|/A_g of a structure (--M 168 --zeta_s 0.0032
+//! --w_s 5.636, seed Table 2.1) with one tank (--breadth 0.32) whose fundamental mode carries
+//! --Omega of m_1 at omega_1/sqrt(Omega) (S^2 without its impacts; the impact mass
+//! --mass_ratio m_1 + (1 - Omega) m_1 left free), and without the tank; frequencies as
+//! fractions of w_s. JSON.
 
+use tld_fmu::analysis::coupled::Coupled;
 use tld_fmu::analysis::harmonic::HarmonicBalance;
 use tld_fmu::physics::geometry::Tank;
 use tld_fmu::physics::nonlinear::PowerLaw;
@@ -14,6 +21,49 @@ fn main() {
         eprintln!("tld-freqresp: {e}");
         std::process::exit(2);
     }
+}
+
+/// The linear structure + sloshing-mode response, as JSON.
+fn coupled_response(tank: &Tank, o: &dyn Fn(&str) -> f64) -> Result<(), String> {
+    let omega = o("Omega");
+    if !(omega > 0.0 && omega <= 1.0) {
+        return Err("--Omega must lie in (0, 1]".into());
+    }
+    let mode = tank.fundamental();
+    let (m, ws) = (o("M"), o("w_s"));
+    let impact = (o("mass_ratio") + 1.0 - omega) * mode.mass;
+    let structure = |mode_mass: f64, rigid: f64| Coupled {
+        structure_mass: m,
+        structure_damping: 2.0 * o("zeta_s") * m * ws,
+        structure_stiffness: m * ws * ws,
+        rigid_mass: rigid,
+        mode_mass,
+        mode_omega: mode.omega / omega.sqrt(),
+        mode_zeta: o("zeta"),
+    };
+    // The liquid at rest moves with the structure; the free impact mass does not act.
+    let with = structure(
+        omega * mode.mass,
+        tank.liquid_mass() - mode.mass - o("mass_ratio") * mode.mass,
+    );
+    let bare = structure(0.0, 0.0);
+    let n = o("points").max(2.0) as usize;
+    let rows: Vec<String> = (0..n)
+        .map(|k| {
+            let r = o("from") + (o("to") - o("from")) * k as f64 / (n - 1) as f64;
+            format!(
+                "[{r}, {}, {}]",
+                with.structure_gain(r * ws),
+                bare.structure_gain(r * ws)
+            )
+        })
+        .collect();
+    println!(
+        "{{\"w_s\": {ws}, \"omega_mode\": {}, \"impact_mass\": {impact}, \"rows\": [{}]}}",
+        mode.omega / omega.sqrt(),
+        rows.join(", ")
+    );
+    Ok(())
 }
 
 fn run() -> Result<(), String> {
@@ -28,14 +78,21 @@ fn run() -> Result<(), String> {
         ("from", 0.8),
         ("to", 1.4),
         ("points", 121.0),
+        ("breadth", 0.32),
+        ("M", 168.0),
+        ("zeta_s", 0.0032),
+        ("w_s", 5.636),
+        ("Omega", 1.0),
+        ("mass_ratio", 0.01),
     ]);
-    let (mut csv, mut json) = (None, false);
+    let (mut csv, mut json, mut coupled) = (None, false, false);
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut i = 0;
     while i < args.len() {
         let key = args[i].trim_start_matches("--");
         match key {
             "json" => json = true,
+            "coupled" => coupled = true,
             "csv" => {
                 csv = Some(args.get(i + 1).ok_or("--csv needs a file")?.clone());
                 i += 1;
@@ -56,6 +113,7 @@ fn run() -> Result<(), String> {
         i += 1;
     }
     let o = |k: &str| opt[k];
+    let o: &dyn Fn(&str) -> f64 = &o;
     if !(o("eta") >= 1.0
         && o("phi") >= 0.0
         && o("zeta") > 0.0
@@ -66,11 +124,14 @@ fn run() -> Result<(), String> {
     }
     let tank = Tank {
         length: o("length"),
-        breadth: 1.0,
+        breadth: o("breadth"),
         depth: o("depth"),
         density: 1000.0,
         g: o("g"),
     };
+    if coupled {
+        return coupled_response(&tank, o);
+    }
     let wf = tank.fundamental().omega;
     let hb = HarmonicBalance {
         law: PowerLaw::new(wf, o("phi"), o("eta"), o("length")),
