@@ -56,6 +56,9 @@ pub enum ModelKind {
     Linear { modes: u32 },
     /// The impact-characteristic model (Eq 2.11 with Eq 2.13).
     Nonlinear,
+    /// The same, stepped by the exact linear propagator while the hardening term stays below
+    /// `threshold` over the step (0: the solver tolerance), by the integrator otherwise.
+    NonlinearAuto { threshold: f64 },
     /// Sloshing-slamming (S^2, Eqs 2.5-2.8): the fundamental mode with mass Omega m_1 on its
     /// unchanged spring (frequency omega_1 / sqrt(Omega)) and an impact mass
     /// (mass_ratio + 1 - Omega) m_1 slamming on the walls across the clearance.
@@ -106,7 +109,9 @@ impl Config {
     fn mode_count(&self) -> u32 {
         match self.model {
             ModelKind::Linear { modes } => modes.max(1),
-            ModelKind::Nonlinear | ModelKind::SloshingSlamming(_) => 1,
+            ModelKind::Nonlinear
+            | ModelKind::NonlinearAuto { .. }
+            | ModelKind::SloshingSlamming(_) => 1,
         }
     }
 
@@ -320,6 +325,9 @@ enum Dynamics {
         integrator: Integrator,
         /// State per unit sloshing mass, see `physics::nonlinear::state`.
         y: [f64; state::DIM],
+        /// model = Auto: the hardening below which a step is taken by the linear propagator, and
+        /// that propagator (kept for its cached coefficients).
+        linear_below: Option<(f64, Mode)>,
     },
     /// Each mode with its total modal mass and state; the first is the fundamental.
     Linear { modes: Vec<(Mode, f64, ModeState)> },
@@ -377,7 +385,7 @@ impl Simulation {
         let zeta = config.zeta(amplitude);
         let tanks = f64::from(config.tanks);
         let (dynamics, initial_energy) = match config.model {
-            ModelKind::Nonlinear => {
+            ModelKind::Nonlinear | ModelKind::NonlinearAuto { .. } => {
                 let stiffness = PowerLaw::new(omega_f, config.phi, config.eta, length);
                 let model = NonlinearTld {
                     stiffness,
@@ -393,6 +401,21 @@ impl Simulation {
                         model,
                         integrator: Self::integrator(&config, omega_f),
                         y,
+                        linear_below: match config.model {
+                            ModelKind::NonlinearAuto { threshold } => {
+                                let tolerance = match config.method {
+                                    Method::Adaptive { rtol, .. } => rtol,
+                                    Method::Rk4 { .. } => 1e-10,
+                                };
+                                let threshold = if threshold > 0.0 {
+                                    threshold
+                                } else {
+                                    tolerance
+                                };
+                                Some((threshold, Mode::new(omega_f, zeta)))
+                            }
+                            _ => None,
+                        },
                     },
                     energy,
                 )
@@ -400,10 +423,7 @@ impl Simulation {
             ModelKind::SloshingSlamming(p) => {
                 let m1 = config.tank.fundamental();
                 let omega = config.mass_exchange(&p, amplitude);
-                let mode = Mode {
-                    omega: m1.omega / omega.sqrt(),
-                    zeta,
-                };
+                let mode = Mode::new(m1.omega / omega.sqrt(), zeta);
                 let sloshing = omega * m1.mass * tanks;
                 let state = ModeState {
                     x: config.x0,
@@ -437,10 +457,7 @@ impl Simulation {
                             (0.0, 0.0)
                         };
                         (
-                            Mode {
-                                omega: m.omega,
-                                zeta,
-                            },
+                            Mode::new(m.omega, zeta),
                             m.mass * tanks,
                             ModeState {
                                 x,
@@ -547,11 +564,46 @@ impl Simulation {
                 model,
                 integrator,
                 y,
+                linear_below,
             } => {
                 let mut next_model = *model;
                 next_model.c = 2.0 * zeta * omega_f;
                 next_model.base = base;
                 let mut next = *y;
+                // model = Auto: while the hardening phi |2x/a|^(2eta-2) stays below the
+                // tolerance over the whole step, Eq 2.11 is linear to that tolerance and its
+                // exact solution is cheaper than any integrator. The bound on |x| over the step:
+                // the free amplitude now, plus twice the static deflection and the growth of one
+                // step under the largest base acceleration of the step.
+                if let Some((threshold, mode)) = linear_below.as_mut() {
+                    let (x, v) = (y[state::X], y[state::V]);
+                    let a_max = base.a[0].abs() + h * (base.a[1].abs() + 0.5 * h * base.a[2].abs());
+                    let bound = (x * x + (v / omega_f).powi(2)).sqrt()
+                        + a_max * (2.0 / (omega_f * omega_f) + h / omega_f);
+                    if next_model.stiffness.hardening(bound) < *threshold {
+                        mode.zeta = zeta;
+                        let mut s = ModeState {
+                            x,
+                            v,
+                            work_in: y[state::WORK_IN],
+                            dissipated: y[state::DISSIPATED],
+                        };
+                        mode.advance(&mut s, h, &base);
+                        next = [s.x, s.v, s.work_in, s.dissipated];
+                        let impulse = mass * (-(next[state::V] - y[state::V]) - base.integral(h));
+                        *y = next;
+                        *model = next_model;
+                        return self.finish_step(
+                            zeta,
+                            tracker,
+                            impulse / h,
+                            SolveStats {
+                                accepted: 1,
+                                ..SolveStats::default()
+                            },
+                        );
+                    }
+                }
                 // The integrators change nothing of themselves when they fail; a runaway found
                 // after a successful integration puts their carried step sizes back.
                 let carried = integrator.memory();
@@ -626,7 +678,18 @@ impl Simulation {
                 )
             }
         };
-        self.last_mean_force = Some(impulse / h);
+        self.finish_step(zeta, tracker, impulse / h, stats)
+    }
+
+    /// Commit what a successful step changed besides the model's state.
+    fn finish_step(
+        &mut self,
+        zeta: f64,
+        tracker: Option<AmplitudeTracker>,
+        mean_force: f64,
+        stats: SolveStats,
+    ) -> Result<SolveStats, StepError> {
+        self.last_mean_force = Some(mean_force);
         self.zeta = zeta;
         if let Some(tr) = tracker {
             self.amplitude = tr.estimate();

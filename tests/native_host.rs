@@ -406,7 +406,7 @@ fn out_of_range_and_inconsistent_parameters() {
         "not an enumeration item"
     );
     assert_eq!(
-        inst.set_integer(vr::MODEL, 4),
+        inst.set_integer(vr::MODEL, 5),
         ERROR,
         "not an item of ModelKind"
     );

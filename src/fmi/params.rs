@@ -126,6 +126,9 @@ impl Values {
                 clearance: g(vr::SLAMMING_CLEARANCE),
                 mass_ratio: g(vr::SLAMMING_MASS_RATIO),
             }),
+            4 => ModelKind::NonlinearAuto {
+                threshold: g(vr::AUTO_THRESHOLD),
+            },
             _ => ModelKind::Nonlinear,
         };
         Config {

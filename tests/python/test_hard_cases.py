@@ -191,3 +191,18 @@ def test_dop853_against_the_reference(slave_factory):
     err = R.rel_err(out["slosh.x"], ref.x)
     print(f"DOP853 at 50 ms, rtol 1e-13: error {err:.2e}")
     assert err < 1e-10
+
+
+@pytest.mark.parametrize("amplitude,dt", [(2e-4, 0.01), (2e-4, 0.001), (0.006, 0.01)],
+                         ids=["wind_10ms", "wind_1ms", "walls_10ms"])
+def test_model_auto_against_the_nonlinear_reference(slave_factory, amplitude, dt):
+    # model = Auto (4) solves Eq 2.11 too: linear steps while the hardening over the step stays
+    # below auto.threshold (default: the solver tolerance), the integrator otherwise. Against
+    # the same independent reference as the Nonlinear model, at wind-level base motion and at
+    # the walls: at the default threshold it must be as accurate as the Nonlinear model.
+    p = R.TLD(eta=2.0, phi=1.0, damping=R.DAMPING_CONSTANT, zeta=0.02)
+    n = int(round(30.0 / dt))
+    _, _, a = R.harmonic_base(1.02 * p.omega_f, amplitude, dt * np.arange(n))
+    out = fmu_run(slave_factory, p, dt, n, {"base.a": a}, extra={"model": 4})
+    ref = R.simulate_held(p, dt, a, substeps=max(1, int(round(dt / 1e-3))))
+    check(out, ref, f"model Auto, base amplitude {amplitude} m, dt {dt}")
