@@ -3,6 +3,7 @@
 //! balance of Eq 2.11 with every branch of the response, and the exact stationary response to
 //! white noise. Pure functions, shared by the command-line tool and the tests.
 
+pub mod calibration;
 pub mod coupled;
 pub mod harmonic;
 pub mod linearisation;
