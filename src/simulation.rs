@@ -314,6 +314,31 @@ impl Integrator {
     }
 }
 
+/// One linear mode (mode, mass, state) advanced exactly by `h`, and the impulse of its force
+/// on the tank over the step (-dv - integral of a_b, per unit mass, times the mass). The mode
+/// given is not changed.
+fn advance_mode(
+    mode: &(Mode, f64, ModeState),
+    zeta: f64,
+    h: f64,
+    base: &BaseAcceleration,
+) -> ((Mode, f64, ModeState), f64) {
+    let mut next = *mode;
+    next.0.zeta = zeta;
+    next.0.advance(&mut next.2, h, base);
+    let impulse = next.1 * (-(next.2.v - mode.2.v) - base.integral(h));
+    (next, impulse)
+}
+
+/// Refuse a step whose sloshing displacement left any physical range.
+fn check_runaway(x: f64, limit: f64) -> Result<(), StepError> {
+    if x.is_nan() || x.abs() > limit {
+        Err(StepError::Runaway { x, limit })
+    } else {
+        Ok(())
+    }
+}
+
 /// What evolves, by model.
 // One per instance: the size difference costs nothing, boxing would add an indirection to
 // every step.
@@ -610,12 +635,9 @@ impl Simulation {
                 let stats = integrator
                     .integrate(&next_model, 0.0, h, &mut next)
                     .map_err(|e| StepError::Solver(e.shifted(t)))?;
-                if next[state::X].abs() > limit {
+                if let Err(e) = check_runaway(next[state::X], limit) {
                     integrator.set_memory(carried);
-                    return Err(StepError::Runaway {
-                        x: next[state::X],
-                        limit,
-                    });
+                    return Err(e);
                 }
                 let impulse = mass * (-(next[state::V] - y[state::V]) - base.integral(h));
                 *y = next;
@@ -625,22 +647,13 @@ impl Simulation {
             Dynamics::Linear { modes } => {
                 // Exact propagation cannot fail; only the fundamental mode can run away (the
                 // higher ones respond less), so it is checked before anything changes.
-                let mut first = modes[0];
-                first.0.zeta = zeta;
-                first.0.advance(&mut first.2, h, &base);
-                if first.2.x.is_nan() || first.2.x.abs() > limit {
-                    return Err(StepError::Runaway {
-                        x: first.2.x,
-                        limit,
-                    });
-                }
-                let mut impulse = first.1 * (-(first.2.v - modes[0].2.v) - base.integral(h));
+                let (first, mut impulse) = advance_mode(&modes[0], zeta, h, &base);
+                check_runaway(first.2.x, limit)?;
                 modes[0] = first;
-                for (mode, m, s) in modes.iter_mut().skip(1) {
-                    mode.zeta = zeta;
-                    let v0 = s.v;
-                    mode.advance(s, h, &base);
-                    impulse += *m * (-(s.v - v0) - base.integral(h));
+                for mode in modes.iter_mut().skip(1) {
+                    let (next, i) = advance_mode(mode, zeta, h, &base);
+                    *mode = next;
+                    impulse += i;
                 }
                 (
                     SolveStats {
@@ -651,22 +664,14 @@ impl Simulation {
                 )
             }
             Dynamics::Slamming { mode, impact } => {
-                let mut sloshing = *mode;
-                sloshing.0.zeta = zeta;
-                sloshing.0.advance(&mut sloshing.2, h, &base);
-                if sloshing.2.x.is_nan() || sloshing.2.x.abs() > limit {
-                    return Err(StepError::Runaway {
-                        x: sloshing.2.x,
-                        limit,
-                    });
-                }
+                let (sloshing, slosh_impulse) = advance_mode(mode, zeta, h, &base);
+                check_runaway(sloshing.2.x, limit)?;
                 let mut slam = impact.2;
                 let per_mass = impact
                     .0
                     .advance(&mut slam, h, &base)
                     .map_err(StepError::Chattering)?;
-                let impulse = sloshing.1 * (-(sloshing.2.v - mode.2.v) - base.integral(h))
-                    + impact.1 * per_mass;
+                let impulse = slosh_impulse + impact.1 * per_mass;
                 *mode = sloshing;
                 impact.2 = slam;
                 (

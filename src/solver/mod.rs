@@ -141,11 +141,18 @@ mod tests {
         }
     }
 
-    #[test]
-    fn sdirk4_meets_its_tolerance_and_is_fourth_order() {
+    /// An error-controlled method meets its tolerance over 100 intervals, and with its step
+    /// held fixed (max_step below what a loose tolerance needs) halving it divides the error by
+    /// 2^order.
+    fn check_tolerance_and_order<M: Embedded<2>>(
+        tols: &[f64],
+        steps: (f64, f64),
+        span: f64,
+        order: i32,
+    ) {
         let w = 5.6389;
-        for rtol in [1e-6, 1e-8, 1e-10] {
-            let mut m = Sdirk4::new(rtol, [1.0, w], f64::INFINITY, 1_000_000);
+        for &rtol in tols {
+            let mut m = Adaptive::<2, M>::new(rtol, [1.0, w], f64::INFINITY, 1_000_000);
             let mut y = [1.0, 0.0];
             for k in 0..100 {
                 m.integrate(&Oscillator(w), k as f64 * 0.1, (k + 1) as f64 * 0.1, &mut y)
@@ -154,15 +161,33 @@ mod tests {
             let e = error_after(&y, w, 10.0);
             assert!(e < 100.0 * rtol, "rtol {rtol}: error {e}");
         }
-        // Fixed steps (max_step below what the tolerance needs): error ratio 2^4 on halving.
         let run = |h: f64| {
-            let mut m = Sdirk4::new(1.0, [1e9, 1e9], h, 1_000_000);
+            let mut m = Adaptive::<2, M>::new(1.0, [1e9, 1e9], h, 1_000_000);
             let mut y = [1.0, 0.0];
-            m.integrate(&Oscillator(w), 0.0, 2.0, &mut y).expect("run");
-            error_after(&y, w, 2.0)
+            m.integrate(&Oscillator(w), 0.0, span, &mut y).expect("run");
+            error_after(&y, w, span)
         };
-        let ratio = run(0.02) / run(0.01);
-        assert!((ratio - 16.0).abs() < 2.0, "error ratio {ratio}");
+        let ratio = run(steps.0) / run(steps.1);
+        let want = 2f64.powi(order);
+        assert!(
+            (ratio / want - 1.0).abs() < 0.25,
+            "error ratio {ratio}, want {want}"
+        );
+    }
+
+    #[test]
+    fn sdirk4_meets_its_tolerance_and_is_fourth_order() {
+        check_tolerance_and_order::<Sdirk4Stages<2>>(&[1e-6, 1e-8, 1e-10], (0.02, 0.01), 2.0, 4);
+    }
+
+    #[test]
+    fn dop853_meets_its_tolerance_and_is_eighth_order() {
+        check_tolerance_and_order::<Dop853Stages<2>>(&[1e-8, 1e-11, 1e-13], (0.2, 0.1), 4.0, 8);
+    }
+
+    #[test]
+    fn dopri5_is_fifth_order() {
+        check_tolerance_and_order::<DormandPrince<2>>(&[1e-6, 1e-9], (0.1, 0.05), 4.0, 5);
     }
 
     /// y' = -L (y - cos t) with L = 1e6: explicit steps are stability-limited to ~3/L, the
@@ -220,30 +245,6 @@ mod tests {
         }
         assert_eq!(auto.implicit_intervals, 0);
         assert!(error_after(&y, w, 400.0 * h) < 1e-3);
-    }
-
-    #[test]
-    fn dop853_meets_its_tolerance_and_is_eighth_order() {
-        let w = 5.6389;
-        for rtol in [1e-8, 1e-11, 1e-13] {
-            let mut m = Dop853::new(rtol, [1.0, w], f64::INFINITY, 100_000);
-            let mut y = [1.0, 0.0];
-            for k in 0..100 {
-                m.integrate(&Oscillator(w), k as f64 * 0.1, (k + 1) as f64 * 0.1, &mut y)
-                    .expect("step");
-            }
-            let e = error_after(&y, w, 10.0);
-            assert!(e < 100.0 * rtol, "rtol {rtol}: error {e}");
-        }
-        // Fixed steps: error ratio 2^8 on halving.
-        let run = |h: f64| {
-            let mut m = Dop853::new(1.0, [1e9, 1e9], h, 1_000_000);
-            let mut y = [1.0, 0.0];
-            m.integrate(&Oscillator(w), 0.0, 4.0, &mut y).expect("run");
-            error_after(&y, w, 4.0)
-        };
-        let ratio = run(0.2) / run(0.1);
-        assert!((ratio / 256.0 - 1.0).abs() < 0.25, "error ratio {ratio}");
     }
 
     #[test]
