@@ -77,11 +77,18 @@ impl Values {
         }
     }
 
+    /// An enumeration's value, or its Integer alias when that is set (hosts that cannot set
+    /// Enumeration variables, such as libcosim, use the alias).
+    fn option(&self, enumeration: u32, alias: u32) -> f64 {
+        let a = self.get(alias);
+        if a > 0.0 { a } else { self.get(enumeration) }
+    }
+
     /// The configuration these values describe. `tolerance` is the experiment's tolerance, used
     /// unless the user set solver.tolerance explicitly.
     pub fn config(&self, tolerance: Option<f64>, user_tolerance: bool) -> Config {
         let g = |r| self.get(r);
-        let damping = if g(vr::DAMPING) == 1.0 {
+        let damping = if self.option(vr::DAMPING, vr::DAMPING_ID) == 1.0 {
             DampingLaw::Constant(g(vr::ZETA))
         } else {
             DampingLaw::Nsd {
@@ -89,7 +96,7 @@ impl Values {
                 p: g(vr::NSD_P),
             }
         };
-        let amplitude = if g(vr::AMPLITUDE) == 2.0 {
+        let amplitude = if self.option(vr::AMPLITUDE, vr::AMPLITUDE_ID) == 2.0 {
             AmplitudeSource::Tracked {
                 tau: g(vr::AMPLITUDE_TAU),
                 prior: g(vr::A_E),
@@ -107,7 +114,7 @@ impl Values {
             rtol,
             max_step: g(vr::SOLVER_MAX_STEP),
         };
-        let method = match g(vr::SOLVER) as i64 {
+        let method = match self.option(vr::SOLVER, vr::SOLVER_ID) as i64 {
             2 => Method::Rk4 {
                 step: g(vr::SOLVER_FIXED_STEP),
             },
@@ -116,7 +123,7 @@ impl Values {
             5 => adaptive(AdaptiveKind::DormandPrince853),
             _ => adaptive(AdaptiveKind::DormandPrince),
         };
-        let model = match g(vr::MODEL) as i64 {
+        let model = match self.option(vr::MODEL, vr::MODEL_ID) as i64 {
             1 => ModelKind::Linear {
                 modes: g(vr::MODES) as u32,
             },

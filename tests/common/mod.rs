@@ -48,8 +48,11 @@ pub fn library_path() -> PathBuf {
         .unwrap_or_else(|_| panic!("{} is not built: run `cargo build` first", path.display()));
     // `cargo test` does not rebuild the cdylib: refuse to test a library older than its sources.
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    // The library is built from src/ (less src/bin) and modelDescription.xml (build.rs).
+    let xml = std::fs::metadata(root.join("modelDescription/modelDescription.xml"))
+        .and_then(|m| m.modified());
     let newest =
-        newest_source(&root.join("src")).max(newest_source(&root.join("modelDescription")));
+        newest_source(&root.join("src")).max(xml.unwrap_or(std::time::SystemTime::UNIX_EPOCH));
     assert!(
         built >= newest,
         "{} is older than the sources: run `cargo build` first",
