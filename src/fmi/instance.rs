@@ -361,8 +361,22 @@ impl Instance {
             .ok_or_else(|| refuse(format!("{function}: unknown value reference {vr}")))
     }
 
-    fn type_matches(var: &Variable, wanted: VarType) -> bool {
-        var.ty == wanted || (wanted == VarType::Integer && var.ty == VarType::Enumeration)
+    /// The variable behind `vr`, if it is of the type `ty` the calling function handles
+    /// (fmi2Get/SetInteger also serve Enumeration variables).
+    fn typed_variable(
+        vr: u32,
+        ty: VarType,
+        function: &str,
+    ) -> Result<(usize, &'static Variable), Refusal> {
+        let (index, var) = Self::variable(vr, function)?;
+        if var.ty == ty || (ty == VarType::Integer && var.ty == VarType::Enumeration) {
+            Ok((index, var))
+        } else {
+            Err(refuse(format!(
+                "{function}: '{}' (value reference {vr}) is of type {:?}",
+                var.name, var.ty
+            )))
+        }
     }
 
     /// Values of the variables `vrs` of type `ty` (integers as f64), handed to `put` by position.
@@ -377,13 +391,7 @@ impl Instance {
         let mut provisional = None;
         let inputs = self.values.inputs(self.a_derivatives);
         for (k, &r) in vrs.iter().enumerate() {
-            let (index, var) = Self::variable(r, function)?;
-            if !Self::type_matches(var, ty) {
-                return Err(refuse(format!(
-                    "{function}: '{}' (value reference {r}) is of type {:?}",
-                    var.name, var.ty
-                )));
-            }
+            let (index, var) = Self::typed_variable(r, ty, function)?;
             let no_value = || refuse(format!("{function}: '{}' has no value", var.name));
             let value = match var.causality {
                 Causality::Parameter | Causality::Input | Causality::Local => self.values.at(index),
@@ -422,13 +430,7 @@ impl Instance {
     }
 
     fn check_set(&self, r: u32, value: f64, ty: VarType, function: &str) -> Result<(), Refusal> {
-        let (_, var) = Self::variable(r, function)?;
-        if !Self::type_matches(var, ty) {
-            return Err(refuse(format!(
-                "{function}: '{}' (value reference {r}) is of type {:?}",
-                var.name, var.ty
-            )));
-        }
+        let (_, var) = Self::typed_variable(r, ty, function)?;
         match var.causality {
             Causality::Parameter => {
                 let before_init =
