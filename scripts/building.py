@@ -1,6 +1,7 @@
 """A structural master for TLD.fmu: an N-storey shear building (storey masses, stiffnesses and
 Rayleigh damping from a TOML file) with TLD FMU instances on chosen floors, under a harmonic
-ground-motion sweep or a ground-acceleration record, coupled by a fixed-step explicit scheme.
+ground-motion sweep, a ground-acceleration record, or band-limited wind-like random forces on the
+floors, coupled by a fixed-step explicit scheme.
 
 Each communication step: read every damper's `force` (state only: no algebraic loop), integrate
 the building over the step with those forces held (RK4), then hand each damper floor's absolute
@@ -10,7 +11,8 @@ The liquid that moves rigidly with a tank (`mass.inactive`) is added to its floo
     .venv/bin/python scripts/building.py scripts/examples/building.toml [--out out/building]
 
 Writes a CSV and PNG plots (sweep: peak roof displacement with and without the dampers;
-record: storey drifts, roof acceleration, damper forces and energies)."""
+record and wind: storey drifts, roof displacement and acceleration with and without the dampers,
+damper forces and energies)."""
 import argparse
 import ctypes
 import math
@@ -50,6 +52,39 @@ class Building:
 
     def accel(self, X, V, F, ag):
         return self.minv * (F - self.C @ V - self.K @ X) - ag
+
+
+def wind_forces(n_floors, dt, duration, force_rms, band, corner, coherence, seed):
+    """Band-limited wind-like random forces on the floors, sampled every dt over [0, duration].
+
+    Each floor's force is a zero-mean Gaussian process with the one-sided spectrum
+    S(f) ~ (1 + (f / corner)^2)^(-5/6) (the von Karman/Kaimal high-frequency roll-off of
+    along-wind turbulence) inside band = [f_lo, f_hi] Hz and nothing outside, scaled to the
+    floor's rms force [N]. Floors share a common part with weight `coherence` (0: independent,
+    1: fully correlated). Built by the spectral representation on the FFT grid (random phases,
+    deterministic amplitudes), so the rms over one period (the duration) is exact and the signal is
+    periodic in the duration. Returns (t, F) with F of shape (len(t), n_floors)."""
+    rng = np.random.default_rng(seed)
+    nfft = max(int(round(duration / dt)), 2)   # one period: the sample at `duration` repeats t = 0
+    f = np.fft.rfftfreq(nfft, dt)
+    f_lo, f_hi = band
+    shape = np.where((f >= f_lo) & (f <= f_hi), (1 + (f / corner) ** 2) ** (-5 / 6), 0.0)
+    if not np.any(shape > 0):
+        raise ValueError(f"wind band {band} Hz holds no frequency of the {nfft * dt:.4g} s grid")
+
+    def unit_process():
+        spec = np.sqrt(shape) * np.exp(2j * np.pi * rng.random(len(f)))
+        g = np.fft.irfft(spec, nfft)
+        return g / np.sqrt(np.mean(g ** 2))
+
+    common = unit_process()
+    rms = np.broadcast_to(np.asarray(force_rms, float), (n_floors,))
+    F = np.empty((nfft + 1, n_floors))
+    for i in range(n_floors):
+        g = math.sqrt(coherence) * common + math.sqrt(1 - coherence) * unit_process()
+        F[:nfft, i] = rms[i] * g / np.sqrt(np.mean(g ** 2))
+    F[nfft] = F[0]
+    return np.arange(nfft + 1) * dt, F
 
 
 def np_eig(K, m):
@@ -100,8 +135,10 @@ class Damper:
         self.fmu.freeInstance()
 
 
-def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True):
-    """Co-simulate; ground(t) -> (a_g, v_g, x_g). Returns the time series."""
+def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_forces=None):
+    """Co-simulate; ground(t) -> (a_g, v_g, x_g). floor_forces, if given, is an array of external
+    forces on the floors [N] sampled every h/2 from t = 0 (the RK4 stage times). Returns the time
+    series."""
     b = cfg["building"]
     n = len(b["masses"])
     dampers = []
@@ -121,17 +158,18 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True):
         F = np.zeros(n)
         for dp in dampers:
             F[dp.floor] += dp.force_mean if k else dp.force
-        def rhs(tt, X_, V_):
-            return V_, bld.accel(X_, V_, F, ground(tt)[0])
+        def rhs(tt, X_, V_, stage):
+            Fe = F if floor_forces is None else F + floor_forces[2 * k + stage]
+            return V_, bld.accel(X_, V_, Fe, ground(tt)[0])
         # RK4 over the step with the dampers' forces held
-        k1 = rhs(t, X, V)
-        k2 = rhs(t + h / 2, X + h / 2 * k1[0], V + h / 2 * k1[1])
-        k3 = rhs(t + h / 2, X + h / 2 * k2[0], V + h / 2 * k2[1])
-        k4 = rhs(t + h, X + h * k3[0], V + h * k3[1])
+        k1 = rhs(t, X, V, 0)
+        k2 = rhs(t + h / 2, X + h / 2 * k1[0], V + h / 2 * k1[1], 1)
+        k3 = rhs(t + h / 2, X + h / 2 * k2[0], V + h / 2 * k2[1], 1)
+        k4 = rhs(t + h, X + h * k3[0], V + h * k3[1], 2)
         X = X + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
         V = V + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
         ag, vg, xg = ground(t + h)
-        A_rel = bld.accel(X, V, F, ag)
+        A_rel = bld.accel(X, V, F if floor_forces is None else F + floor_forces[2 * k + 2], ag)
         for j, dp in enumerate(dampers):
             i = dp.floor
             dp.step(t, h, ag + A_rel[i], vg + V[i], xg + X[i])
@@ -184,25 +222,54 @@ def main(argv=None):
         plt.tight_layout(); plt.savefig(out / "sweep.png", dpi=120)
         print(f"peak roof displacement: {rows[:, 1].max() * 1e3:.3f} mm without, {rows[:, 2].max() * 1e3:.3f} mm "
               f"with dampers ({100 * (1 - rows[:, 2].max() / rows[:, 1].max()):.1f} % less); wrote {out}/sweep.csv, sweep.png")
+    elif load["kind"] in ("record", "wind"):
+        if load["kind"] == "record":
+            rec = np.loadtxt(Path(args.config).parent / load["record"], delimiter=",")
+            tt, aa = rec[:, 0], rec[:, 1]
+            vv = np.concatenate([[0], np.cumsum((aa[1:] + aa[:-1]) / 2 * np.diff(tt))])
+            xx = np.concatenate([[0], np.cumsum((vv[1:] + vv[:-1]) / 2 * np.diff(tt))])
+            ground = lambda t: (np.interp(t, tt, aa), np.interp(t, tt, vv), np.interp(t, tt, xx))  # noqa: E731
+            duration, forces = tt[-1], None
+        else:
+            duration = load["duration"]
+            ground = lambda t: (0.0, 0.0, 0.0)  # noqa: E731
+            _, forces = wind_forces(len(cfg["building"]["masses"]), h / 2, duration, load["force_rms"],
+                                    load.get("band", [0.02, 5.0]), load.get("corner", 0.1),
+                                    load.get("coherence", 0.5), load.get("seed", 1))
+        runs = {}
+        for damped in tqdm((False, True), desc=load["kind"]):
+            runs[damped] = simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=damped, floor_forces=forces)
+        write_histories(out, load["kind"], runs[True], runs[False], plt)
     else:
-        rec = np.loadtxt(Path(args.config).parent / load["record"], delimiter=",")
-        tt, aa = rec[:, 0], rec[:, 1]
-        vv = np.concatenate([[0], np.cumsum((aa[1:] + aa[:-1]) / 2 * np.diff(tt))])
-        xx = np.concatenate([[0], np.cumsum((vv[1:] + vv[:-1]) / 2 * np.diff(tt))])
-        ground = lambda t: (np.interp(t, tt, aa), np.interp(t, tt, vv), np.interp(t, tt, xx))  # noqa: E731
-        s = simulate(cfg, unzipdir, md, ground, h, tt[-1])
-        drift = np.diff(np.column_stack([np.zeros(len(s["t"])), s["X"]]), axis=1)
-        cols = [s["t"], *drift.T, s["A"][:, -1], *s["F"].T, *s["E"].T]
-        names = ["t"] + [f"drift{i + 1}" for i in range(drift.shape[1])] + ["roof_acc"] + \
-                [f"force{j}" for j in range(s["F"].shape[1])] + [f"dissipated{j}" for j in range(s["E"].shape[1])]
-        np.savetxt(out / "record.csv", np.column_stack(cols), delimiter=",", header=",".join(names), comments="")
-        fig, ax = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
-        ax[0].plot(s["t"], drift * 1e3); ax[0].set_ylabel("storey drift [mm]")
-        ax[1].plot(s["t"], s["A"][:, -1]); ax[1].set_ylabel("roof acc. [m/s2]")
-        ax[2].plot(s["t"], s["F"]); ax[2].set_ylabel("damper force [N]")
-        ax[3].plot(s["t"], s["E"]); ax[3].set_ylabel("dissipated [J]"); ax[3].set_xlabel("t [s]")
-        fig.tight_layout(); fig.savefig(out / "record.png", dpi=120)
-        print(f"wrote {out}/record.csv, record.png")
+        sys.exit(f"unknown load kind {load['kind']!r}: harmonic, record or wind")
+
+
+def write_histories(out, kind, s, bare, plt):
+    """CSV and PNG of a time-history run (with dampers: s; without: bare), and the reductions."""
+    drift = np.diff(np.column_stack([np.zeros(len(s["t"])), s["X"]]), axis=1)
+    cols = [s["t"], *drift.T, s["X"][:, -1], bare["X"][:, -1], s["A"][:, -1], bare["A"][:, -1], *s["F"].T, *s["E"].T]
+    names = (["t"] + [f"drift{i + 1}" for i in range(drift.shape[1])]
+             + ["roof_disp", "roof_disp_bare", "roof_acc", "roof_acc_bare"]
+             + [f"force{j}" for j in range(s["F"].shape[1])] + [f"dissipated{j}" for j in range(s["E"].shape[1])])
+    np.savetxt(out / f"{kind}.csv", np.column_stack(cols), delimiter=",", header=",".join(names), comments="")
+    fig, ax = plt.subplots(5, 1, figsize=(8, 11), sharex=True)
+    ax[0].plot(s["t"], drift * 1e3); ax[0].set_ylabel("storey drift [mm]")
+    ax[1].plot(bare["t"], bare["X"][:, -1] * 1e3, "k", lw=0.6, label="without dampers")
+    ax[1].plot(s["t"], s["X"][:, -1] * 1e3, "C0", lw=0.6, label="with TLD.fmu")
+    ax[1].set_ylabel("roof displ. [mm]"); ax[1].legend(loc="upper right")
+    ax[2].plot(bare["t"], bare["A"][:, -1], "k", lw=0.6); ax[2].plot(s["t"], s["A"][:, -1], "C0", lw=0.6)
+    ax[2].set_ylabel("roof acc. [m/s2]")
+    ax[3].plot(s["t"], s["F"]); ax[3].set_ylabel("damper force [N]")
+    ax[4].plot(s["t"], s["E"]); ax[4].set_ylabel("dissipated [J]"); ax[4].set_xlabel("t [s]")
+    fig.tight_layout(); fig.savefig(out / f"{kind}.png", dpi=120)
+    rms = lambda y: float(np.sqrt(np.mean(y ** 2)))  # noqa: E731
+    peak = lambda y: float(np.max(np.abs(y)))  # noqa: E731
+    for label, f in (("rms", rms), ("peak", peak)):
+        d, d0 = f(s["X"][:, -1]), f(bare["X"][:, -1])
+        a, a0 = f(s["A"][:, -1]), f(bare["A"][:, -1])
+        print(f"{label} roof displacement {d0 * 1e3:.3f} -> {d * 1e3:.3f} mm ({100 * (1 - d / d0):.1f} % less), "
+              f"roof acceleration {a0:.4f} -> {a:.4f} m/s2 ({100 * (1 - a / a0):.1f} % less)")
+    print(f"wrote {out}/{kind}.csv, {kind}.png")
 
 
 if __name__ == "__main__":

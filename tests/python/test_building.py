@@ -15,6 +15,7 @@ import tomllib
 from pathlib import Path
 
 import numpy as np
+import pytest
 from scipy.integrate import solve_ivp
 
 REPO = Path(__file__).resolve().parents[2]
@@ -25,13 +26,25 @@ CFG = tomllib.loads((REPO / "scripts" / "examples" / "building.toml").read_text(
 ZETA = 0.02
 
 
-def test_cosimulation_converges_to_the_monolithic_solution(fmu_path, model_description, unzipdir):
+@pytest.mark.parametrize("load", ["ground", "floor_forces"])
+def test_cosimulation_converges_to_the_monolithic_solution(fmu_path, model_description, unzipdir, load):
+    """load = ground: harmonic ground motion; floor_forces: forces on every floor (the path the
+    wind loading takes), here a smooth known function so that the monolithic solver sees the
+    same load at every instant."""
     cfg = {**CFG, "dampers": [{**d, "params": {"model": 1, "modes": 1, "damping": 1, "zeta": ZETA}}
                               for d in CFG["dampers"]]}
     b = cfg["building"]
     w = 0.97 * building.Building(b["masses"], b["stiffnesses"], b["rayleigh"]).omega1
     Ag = 2e-4
-    ground = lambda t: (-w * w * Ag * math.sin(w * t), w * Ag * math.cos(w * t), Ag * math.sin(w * t))  # noqa: E731
+    n_floors = len(b["masses"])
+    if load == "ground":
+        ground = lambda t: (-w * w * Ag * math.sin(w * t), w * Ag * math.cos(w * t), Ag * math.sin(w * t))  # noqa: E731
+        wind = lambda t: np.zeros(n_floors)  # noqa: E731
+    else:
+        ground = lambda t: (0.0, 0.0, 0.0)  # noqa: E731
+        # floor i: (0.5 + 0.25 i) N at w, plus a slower component, different phase per floor
+        wind = lambda t: np.array([(0.5 + 0.25 * i) * math.sin(w * t + i) + 0.3 * math.cos(0.4 * w * t)  # noqa: E731
+                                   for i in range(n_floors)])
     T = 20.0
     # the dampers' masses and frequency, as the FMU reports them
     from fmpy.fmi2 import FMU2Slave  # noqa: F401  (the Damper class uses it)
@@ -52,13 +65,14 @@ def test_cosimulation_converges_to_the_monolithic_solution(fmu_path, model_descr
         F = np.zeros(n)
         F[floor] = m_d * (c_d * v + w_d ** 2 * x)
         ag = ground(t)[0]
-        A = bld.accel(X, V, F, ag)
+        A = bld.accel(X, V, F + wind(t), ag)
         return np.concatenate([V, A, [v, -(ag + A[floor]) - c_d * v - w_d ** 2 * x]])
 
     dts = [4e-3, 2e-3, 1e-3]
     errors = []
     for dt in dts:
-        s = building.simulate(cfg, unzipdir, model_description, ground, dt, T)
+        forces = None if load == "ground" else np.array([wind(t) for t in np.arange(2 * int(round(T / dt)) + 1) * dt / 2])
+        s = building.simulate(cfg, unzipdir, model_description, ground, dt, T, floor_forces=forces)
         ref = solve_ivp(rhs, (0, T), np.zeros(2 * n + 2), method="DOP853", rtol=1e-11, atol=1e-14,
                         t_eval=s["t"])
         roof = ref.y[n - 1]
@@ -69,3 +83,29 @@ def test_cosimulation_converges_to_the_monolithic_solution(fmu_path, model_descr
     # first order: halving the step halves the error (within 15 %)
     for r in ratios:
         assert abs(r - 2.0) < 0.3, ratios
+
+
+@pytest.mark.parametrize("coherence", [0.0, 0.5, 1.0])
+def test_wind_forces_have_the_requested_rms_band_and_spectrum(coherence):
+    """The wind generator: exact rms per floor, no power outside the band, the von Karman
+    roll-off inside it, and the requested correlation between floors."""
+    dt, T, band, corner = 5e-3, 600.0, (0.05, 2.0), 0.3
+    rms = [1.0, 2.0, 3.0]
+    t, F = building.wind_forces(3, dt, T, rms, band, corner, coherence, seed=7)
+    assert F.shape == (len(t), 3) and abs(t[-1] - T) < 1e-9
+    assert np.allclose(np.sqrt(np.mean(F[:-1] ** 2, axis=0)), rms, rtol=1e-12) and np.array_equal(F[0], F[-1])
+    for i in range(3):
+        P = np.abs(np.fft.rfft(F[:-1, i])) ** 2
+        f = np.fft.rfftfreq(len(F) - 1, dt)
+        inside = (f >= band[0]) & (f <= band[1])
+        assert P[~inside].sum() < 1e-20 * P[inside].sum()
+        if coherence == 1.0:
+            # one process per floor, deterministic amplitudes: the periodogram is the shape itself
+            shape = (1 + (f[inside] / corner) ** 2) ** (-5 / 6)
+            ratio = P[inside] / shape
+            assert np.ptp(ratio) < 1e-6 * ratio.mean()
+    c = np.corrcoef(F.T)
+    off = c[np.triu_indices(3, 1)]
+    print(f"\ncoherence {coherence}: floor correlations {np.round(off, 3)}")
+    # independent processes of ~1000 random phases: the sample correlation scatters by ~0.05
+    assert np.all(np.abs(off - coherence) < 0.1), off
