@@ -103,6 +103,19 @@ class Damper:
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
         self.fmu.instantiate()
+        vr = lambda n: self.var[n].valueReference  # noqa: E731
+        f = self.fmu._functions
+        self._set, self._get, self._step = f["fmi2SetReal"], f["fmi2GetReal"], f["fmi2DoStep"]
+        self._in = (ctypes.c_uint * 3)(vr("base.a"), vr("base.v"), vr("base.x"))
+        self._out = (ctypes.c_uint * 4)(vr("force"), vr("force.mean"), vr("energy.dissipated"), vr("slosh.x"))
+        self._iv, self._ov = (ctypes.c_double * 3)(), (ctypes.c_double * 4)()
+        self.configure(floor, tanks, params, fresh=True)
+
+    def configure(self, floor, tanks, params, fresh=False):
+        """Set the parameters and initialise; on an instance already used, fmi2Reset first (so
+        one instance serves many runs of a study)."""
+        if not fresh:
+            self.fmu.reset()
         self.fmu.setupExperiment(startTime=0.0)
         for k, v in {"tanks": tanks, **params}.items():
             var = self.var[k]
@@ -110,13 +123,7 @@ class Damper:
         self.fmu.enterInitializationMode()
         self.fmu.exitInitializationMode()
         self.floor = floor - 1
-        vr = lambda n: self.var[n].valueReference  # noqa: E731
-        self.inactive = self.fmu.getReal([vr("mass.inactive")])[0]
-        f = self.fmu._functions
-        self._set, self._get, self._step = f["fmi2SetReal"], f["fmi2GetReal"], f["fmi2DoStep"]
-        self._in = (ctypes.c_uint * 3)(vr("base.a"), vr("base.v"), vr("base.x"))
-        self._out = (ctypes.c_uint * 4)(vr("force"), vr("force.mean"), vr("energy.dissipated"), vr("slosh.x"))
-        self._iv, self._ov = (ctypes.c_double * 3)(), (ctypes.c_double * 4)()
+        self.inactive = self.fmu.getReal([self.var["mass.inactive"].valueReference])[0]
         self.read()
 
     def read(self):
@@ -135,17 +142,38 @@ class Damper:
         self.fmu.freeInstance()
 
 
-def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_forces=None):
+class DamperPool:
+    """FMU instances kept across runs: the k-th damper of a run reuses the k-th instance through
+    fmi2Reset instead of loading and instantiating a new one."""
+
+    def __init__(self, unzipdir, md):
+        self.unzipdir, self.md, self.dampers = unzipdir, md, []
+
+    def get(self, k, floor, tanks, params):
+        if k < len(self.dampers):
+            self.dampers[k].configure(floor, tanks, params)
+        else:
+            self.dampers.append(Damper(self.unzipdir, self.md, floor, tanks, params, f"tld{k}"))
+        return self.dampers[k]
+
+    def close(self):
+        for d in self.dampers:
+            d.close()
+        self.dampers = []
+
+
+def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_forces=None, pool=None):
     """Co-simulate; ground(t) -> (a_g, v_g, x_g). floor_forces, if given, is an array of external
-    forces on the floors [N] sampled every h/2 from t = 0 (the RK4 stage times). Returns the time
-    series."""
+    forces on the floors [N] sampled every h/2 from t = 0 (the RK4 stage times). pool, if given,
+    a DamperPool that provides (and keeps) the FMU instances. Returns the time series."""
     b = cfg["building"]
     n = len(b["masses"])
     dampers = []
     extra = np.zeros(n)
     if with_dampers:
         for k, d in enumerate(cfg.get("dampers", [])):
-            dp = Damper(unzipdir, md, d["floor"], d.get("tanks", 1), d.get("params", {}), f"tld{k}")
+            args = (d["floor"], d.get("tanks", 1), d.get("params", {}))
+            dp = pool.get(k, *args) if pool is not None else Damper(unzipdir, md, *args, f"tld{k}")
             dampers.append(dp)
             extra[dp.floor] += dp.inactive
     bld = Building(b["masses"], b["stiffnesses"], b["rayleigh"], extra)
@@ -175,8 +203,9 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
             dp.step(t, h, ag + A_rel[i], vg + V[i], xg + X[i])
             out["F"][k + 1, j], out["E"][k + 1, j] = dp.force, dp.dissipated
         out["X"][k + 1], out["A"][k + 1] = X, ag + A_rel
-    for dp in dampers:
-        dp.close()
+    if pool is None:
+        for dp in dampers:
+            dp.close()
     out["omega1"] = bld.omega1
     return out
 

@@ -844,7 +844,7 @@ def plots(scenes, rows, outdir: Path, tag):
 
 
 def write_report(args, scenes, refs, rows, stderr_lines, timings, out_md: Path, img_dir: Path,
-                 pyfmu_note, fi: FmuInfo, xcheck):
+                 pyfmu_note, fi: FmuInfo, xcheck, extra_sections=()):
     mi = machine_info()
     L = []
     quick = args.quick
@@ -1033,6 +1033,7 @@ def write_report(args, scenes, refs, rows, stderr_lines, timings, out_md: Path, 
             L.append(f"... {len(stderr_lines) - 40} more")
         L.append("```")
         L.append("")
+    L.extend(extra_sections)
     L.append("## Reproduce")
     L.append("")
     L.append("```sh\nscripts/bench            # full run, writes docs/BENCHMARKS.md and docs/bench/\n"
@@ -1239,6 +1240,62 @@ def targets(scenes, rows):
 
 
 # ------------------------------------------------------------------------------------------------
+# The design-study throughput (issue: "runs per second for 1 and 2 workers"): scripts/sweep.py's
+# study machinery on a fixed small study, serially in this process and on LocalClusters of 1 and
+# 2 single-threaded worker processes; the clusters are started before the clock runs.
+SWEEP_STUDY = {
+    "structure": {"mass": 168.0, "damping": 0.0032},
+    "damper": {"params": {"amplitude": 2}},
+    "study": {"tuning": [0.95, 1.05], "tanks": [1, 2], "ground_amplitude": [1e-4], "frequency": [0.8, 1.2, 10]},
+    "run": {"duration": 20.0, "tail": 5.0, "step": 5e-3},
+}
+
+
+def sweep_throughput(fmu: Path, quick: bool, repeats: int = 3):
+    """[(label, runs, median wall [s], runs/s)] for serial, 1 and 2 workers, and the steps per
+    run; each timed `repeats` times on the same client (after the first, the workers' FMU
+    instances are warm)."""
+    sys.path.insert(0, str(REPO / "scripts"))
+    import sweep
+    study = json.loads(json.dumps(SWEEP_STUDY))
+    if quick:
+        study["study"]["frequency"][2], study["run"]["duration"], repeats = 3, 4.0, 1
+    out = []
+    for label, workers in (("serial (this process, no dask)", 0), ("LocalCluster, 1 worker", 1),
+                           ("LocalCluster, 2 workers", 2)):
+        client = cluster = None
+        if workers:
+            client, cluster = sweep.connect(None, workers)
+        try:
+            walls = []
+            for _ in range(repeats):
+                rows, wall = sweep.run_study(study, fmu, client, progress=False)
+                walls.append(wall)
+        finally:
+            if client is not None:
+                client.close()
+                cluster.close()
+        w = float(np.median(walls))
+        out.append((label, len(rows), w, len(rows) / w))
+    steps = int(round(study["run"]["duration"] / study["run"]["step"]))
+    return out, steps, repeats
+
+
+def sweep_section(result) -> list[str]:
+    rows, steps, repeats = result
+    base = rows[0][3]
+    L = ["## Design-study throughput (scripts/sweep.py on dask.distributed)", "",
+         f"A fixed study of {rows[0][1]} runs (one-mode Table 2.1 structure + TLD.fmu, {steps} communication "
+         "steps each through the Python master of scripts/building.py, FMU instances reused through "
+         f"fmi2Reset), median wall time of {repeats} repetitions; cluster start-up not included. A run's "
+         "cost is mostly the Python master (~30 µs per step), not the FMU.", "",
+         "| where | runs | wall [s] | runs/s | vs serial |", "|---|---:|---:|---:|---:|"]
+    for label, n, w, rps in rows:
+        L.append(f"| {label} | {n} | {w:.2f} | {rps:.2f} | {rps / base:.2f}× |")
+    L.append("")
+    return L
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="smoke run (< 1 minute)")
@@ -1313,17 +1370,23 @@ def main():
     timings["python baselines"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
+    sweep_result = sweep_throughput(fmu_copy, args.quick)
+    timings["sweep throughput"] = time.perf_counter() - t0
+    for label, n, w, rps in sweep_result[0]:
+        print(f"  sweep: {label}: {n} runs in {w:.2f} s = {rps:.2f} runs/s", flush=True)
+
+    t0 = time.perf_counter()
     plots(scenes, rows, img, "")
     timings["report"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     timings["_ref_computed"] = ref_computed
     tgt = write_report(args, scenes, refs, rows, stderr_lines, timings, out / "BENCHMARKS.md", img,
-                       pyfmu_note, fi, xcheck)
+                       pyfmu_note, fi, xcheck, sweep_section(sweep_result))
     clean = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
     (img / "results.json").write_text(json.dumps(dict(
         timings=timings, targets=tgt, rows=clean,
         scenes=[dict(key=s.key, title=s.title, T=s.T, dts=s.dts, describe=s.describe)
-                for s in scenes]), indent=1, default=str))
+                for s in scenes], sweep=sweep_result), indent=1, default=str))
     shutil.rmtree(fi.unzip, ignore_errors=True)
     print(f"wrote {out / 'BENCHMARKS.md'} and {img}/ in {timings['total']:.0f} s")
     for k, v in tgt["summary"].items():

@@ -1,0 +1,99 @@
+"""scripts/sweep.py: design studies on dask.distributed, FMU instances reused through fmi2Reset.
+
+The distributed runs must give exactly the numbers of serial runs on fresh instances (reuse
+through fmi2Reset and the trip through dask change nothing), on a LocalCluster started by the
+script and on an existing scheduler given by address."""
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "scripts"))
+import sweep  # noqa: E402
+
+pytest.importorskip("distributed")   # pinned in scripts/requirements.txt; here for clarity only
+
+STUDY = {
+    "structure": {"mass": 168.0, "damping": 0.0032},
+    "damper": {"params": {"amplitude": 2}},
+    # two tank counts: a pooled instance is reset from 1 to 2 tanks and back between runs
+    "study": {"tuning": [0.95, 1.05], "tanks": [1, 2], "ground_amplitude": [1e-4], "frequency": [0.9, 1.1, 3]},
+    "run": {"duration": 8.0, "tail": 4.0, "step": 5e-3},
+}
+VALUES = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "frequency_ratio", "peak_displacement"]
+
+
+def fresh_rows(fmu_path):
+    """The reference: every run serially, on a new FMU instance each."""
+    data = Path(fmu_path).read_bytes()
+    digest = sweep.hashlib.sha256(data).hexdigest()
+    unzipdir, md, _ = sweep._fmu_on_worker(data, digest)
+    return [sweep.run_one(data, digest, STUDY, r, fresh=True) for r in sweep.expand(STUDY, unzipdir, md)]
+
+
+def assert_same(rows, ref):
+    assert len(rows) == len(ref) == 12
+    for r, q in zip(rows, ref):
+        for k in VALUES:
+            assert r[k] == q[k], (k, r, q)
+
+
+@pytest.fixture(scope="module")
+def reference(fmu_path):
+    return fresh_rows(fmu_path)
+
+
+def test_local_cluster_matches_fresh_serial_runs_and_reuses_instances(fmu_path, reference):
+    client, cluster = sweep.connect(None, 2)
+    try:
+        rows, wall = sweep.run_study(STUDY, fmu_path, client, progress=False)
+    finally:
+        client.close()
+        cluster.close()
+    assert_same(rows, reference)
+    workers = {r["worker"] for r in rows}
+    runs_per_worker = [sum(r["worker"] == w for r in rows) for w in workers]
+    print(f"\n{len(rows)} runs on {len(workers)} workers {runs_per_worker} in {wall:.2f} s")
+    # one damper per run: each worker made one instance, however many runs it did
+    assert max(r["instances"] for r in rows) == 1
+    assert max(runs_per_worker) > 1
+    # the study says something: more tanks, lower resonant amplification at tuning 0.95
+    at = lambda tanks: max(r["amplification"] for r in rows if r["tanks"] == tanks and r["tuning"] == 0.95)  # noqa: E731
+    assert at(2) < 0.8 * at(1)
+
+
+def test_existing_scheduler_by_address_writes_table_and_heat_maps(fmu_path, reference, tmp_path):
+    import tomllib  # noqa: F401  (the study goes through a TOML file, as a user gives it)
+    from distributed import LocalCluster
+    study_file = tmp_path / "study.toml"
+    study_file.write_text(toml(STUDY))
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=True, dashboard_address=":0") as cluster:
+        rows = sweep.main([str(study_file), "--scheduler", cluster.scheduler_address,
+                           "--fmu", str(fmu_path), "--out", str(tmp_path / "out")])
+    assert_same(rows, reference)
+    table = np.genfromtxt(tmp_path / "out" / "study.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    assert len(table) == 12
+    assert np.array_equal(table["peak_displacement"], [r["peak_displacement"] for r in reference])
+    assert (tmp_path / "out" / "study.png").stat().st_size > 10_000
+
+
+def test_serial_mode_reuses_one_instance(fmu_path, reference, tmp_path):
+    study_file = tmp_path / "study.toml"
+    study_file.write_text(toml(STUDY))
+    rows = sweep.main([str(study_file), "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path)])
+    assert_same(rows, reference)
+    assert len({r["worker"] for r in rows}) == 1 and max(r["instances"] for r in rows) == 1
+
+
+def toml(d: dict) -> str:
+    """A minimal TOML writer for the study dict (tables of scalars, lists and inline tables)."""
+    def value(v):
+        if isinstance(v, dict):
+            return "{ " + ", ".join(f'"{k}" = {value(x)}' for k, x in v.items()) + " }"
+        if isinstance(v, list):
+            return "[" + ", ".join(value(x) for x in v) + "]"
+        return repr(v)
+    return "".join(f"[{name}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in table.items())
+                   for name, table in d.items())
