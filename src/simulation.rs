@@ -591,9 +591,13 @@ impl Simulation {
                 y,
                 linear_below,
             } => {
-                let mut next_model = *model;
-                next_model.c = 2.0 * zeta * omega_f;
-                next_model.base = base;
+                // The model takes this step's damping and input in place (field by field: a
+                // whole-struct copy here stalls on store forwarding) and gets its previous ones
+                // back if the step fails.
+                let previous = (model.c, model.base);
+                model.c = 2.0 * zeta * omega_f;
+                model.base.t0 = 0.0;
+                model.base.a = [inputs.a, a1, a2];
                 let mut next = *y;
                 // model = Auto: while the hardening phi |2x/a|^(2eta-2) stays below the
                 // tolerance over the whole step, Eq 2.11 is linear to that tolerance and its
@@ -605,7 +609,7 @@ impl Simulation {
                     let a_max = base.a[0].abs() + h * (base.a[1].abs() + 0.5 * h * base.a[2].abs());
                     let bound = (x * x + (v / omega_f).powi(2)).sqrt()
                         + a_max * (2.0 / (omega_f * omega_f) + h / omega_f);
-                    if next_model.stiffness.hardening(bound) < *threshold {
+                    if model.stiffness.hardening(bound) < *threshold {
                         mode.zeta = zeta;
                         let mut s = ModeState {
                             x,
@@ -617,7 +621,6 @@ impl Simulation {
                         next = [s.x, s.v, s.work_in, s.dissipated];
                         let impulse = mass * (-(next[state::V] - y[state::V]) - base.integral(h));
                         *y = next;
-                        *model = next_model;
                         return self.finish_step(
                             zeta,
                             tracker,
@@ -632,16 +635,20 @@ impl Simulation {
                 // The integrators change nothing of themselves when they fail; a runaway found
                 // after a successful integration puts their carried step sizes back.
                 let carried = integrator.memory();
-                let stats = integrator
-                    .integrate(&next_model, 0.0, h, &mut next)
-                    .map_err(|e| StepError::Solver(e.shifted(t)))?;
-                if let Err(e) = check_runaway(next[state::X], limit) {
-                    integrator.set_memory(carried);
-                    return Err(e);
-                }
+                let outcome = integrator
+                    .integrate(model, 0.0, h, &mut next)
+                    .map_err(|e| StepError::Solver(e.shifted(t)))
+                    .and_then(|stats| check_runaway(next[state::X], limit).map(|()| stats));
+                let stats = match outcome {
+                    Ok(stats) => stats,
+                    Err(e) => {
+                        (model.c, model.base) = previous;
+                        integrator.set_memory(carried);
+                        return Err(e);
+                    }
+                };
                 let impulse = mass * (-(next[state::V] - y[state::V]) - base.integral(h));
                 *y = next;
-                *model = next_model;
                 (stats, impulse)
             }
             Dynamics::Linear { modes } => {

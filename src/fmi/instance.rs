@@ -355,14 +355,30 @@ impl Instance {
         provisional.as_ref().ok_or_else(|| refuse("no simulation"))
     }
 
+    #[inline]
     fn variable(vr: u32, function: &str) -> Result<(usize, &'static Variable), Refusal> {
-        index_of(vr)
-            .and_then(|i| VARIABLES.get(i).map(|v| (i, v)))
-            .ok_or_else(|| refuse(format!("{function}: unknown value reference {vr}")))
+        match index_of(vr).and_then(|i| VARIABLES.get(i).map(|v| (i, v))) {
+            Some(found) => Ok(found),
+            None => Err(Self::unknown(vr, function)),
+        }
+    }
+
+    #[cold]
+    fn unknown(vr: u32, function: &str) -> Refusal {
+        refuse(format!("{function}: unknown value reference {vr}"))
+    }
+
+    #[cold]
+    fn wrong_type(vr: u32, var: &Variable, function: &str) -> Refusal {
+        refuse(format!(
+            "{function}: '{}' (value reference {vr}) is of type {:?}",
+            var.name, var.ty
+        ))
     }
 
     /// The variable behind `vr`, if it is of the type `ty` the calling function handles
     /// (fmi2Get/SetInteger also serve Enumeration variables).
+    #[inline]
     fn typed_variable(
         vr: u32,
         ty: VarType,
@@ -372,10 +388,7 @@ impl Instance {
         if var.ty == ty || (ty == VarType::Integer && var.ty == VarType::Enumeration) {
             Ok((index, var))
         } else {
-            Err(refuse(format!(
-                "{function}: '{}' (value reference {vr}) is of type {:?}",
-                var.name, var.ty
-            )))
+            Err(Self::wrong_type(vr, var, function))
         }
     }
 
@@ -392,7 +405,7 @@ impl Instance {
         let inputs = self.values.inputs(self.a_derivatives);
         for (k, &r) in vrs.iter().enumerate() {
             let (index, var) = Self::typed_variable(r, ty, function)?;
-            let no_value = || refuse(format!("{function}: '{}' has no value", var.name));
+            let no_value = || Self::no_value(var, function);
             let value = match var.causality {
                 Causality::Parameter | Causality::Input | Causality::Local => self.values.at(index),
                 Causality::CalculatedParameter => {
@@ -404,12 +417,20 @@ impl Instance {
                 }
                 Causality::Output => {
                     let which = output_of(r).ok_or_else(no_value)?;
-                    self.simulation(&mut provisional)?.output(which, &inputs)
+                    match &self.sim {
+                        Some(sim) => sim.output(which, &inputs),
+                        None => self.simulation(&mut provisional)?.output(which, &inputs),
+                    }
                 }
             };
             put(k, value);
         }
         Ok(Status::Ok)
+    }
+
+    #[cold]
+    fn no_value(var: &Variable, function: &str) -> Refusal {
+        refuse(format!("{function}: '{}' has no value", var.name))
     }
 
     /// Set the variables `vrs` of type `ty`: all are checked before any is changed.

@@ -19,6 +19,17 @@ enum Power {
 /// a generic routine several times slower, and this sits in the innermost loop.
 #[inline(always)]
 fn int_pow(x: f64, mut n: u32) -> f64 {
+    // eta = 1.5, 2, 2.5, 3 (the usual range): no loop
+    match n {
+        1 => return x,
+        2 => return x * x,
+        3 => return x * x * x,
+        4 => {
+            let s = x * x;
+            return s * s;
+        }
+        _ => {}
+    }
     let (mut base, mut out) = (x, 1.0);
     while n > 0 {
         if n & 1 == 1 {
