@@ -150,7 +150,7 @@ impl BaseAcceleration {
 
     /// Integral of a from t0 to t0 + h.
     pub fn integral(&self, h: f64) -> f64 {
-        h * (self.a[0] + h * (0.5 * self.a[1] + h * self.a[2] / 6.0))
+        h * (self.a[0] + h * (0.5 * self.a[1] + h * self.a[2] * (1.0 / 6.0)))
     }
 }
 
