@@ -106,6 +106,9 @@ class Damper:
         vr = lambda n: self.var[n].valueReference  # noqa: E731
         f = self.fmu._functions
         self._set, self._get, self._step = f["fmi2SetReal"], f["fmi2GetReal"], f["fmi2DoStep"]
+        self._set_der, self._get_der = f["fmi2SetRealInputDerivatives"], f["fmi2GetRealOutputDerivatives"]
+        self._a_vr, self._f_vr = (ctypes.c_uint * 1)(vr("base.a")), (ctypes.c_uint * 1)(vr("force"))
+        self._order1, self._der = (ctypes.c_int * 1)(1), (ctypes.c_double * 1)()
         self._in = (ctypes.c_uint * 3)(vr("base.a"), vr("base.v"), vr("base.x"))
         self._out = (ctypes.c_uint * 4)(vr("force"), vr("force.mean"), vr("energy.dissipated"), vr("slosh.x"))
         self._iv, self._ov = (ctypes.c_double * 3)(), (ctypes.c_double * 4)()
@@ -131,11 +134,26 @@ class Damper:
             raise RuntimeError("fmi2GetReal failed")
         self.force, self.force_mean, self.dissipated, self.x = self._ov[:]
 
-    def step(self, t, h, a, v, x):
+    def step(self, t, h, a, v, x, a_rate=None):
+        """fmi2DoStep from t by h with the floor's absolute motion at the step's start; a_rate, if
+        given, is d(base.a)/dt there (fmi2SetRealInputDerivatives, order 1)."""
         self._iv[:] = (a, v, x)
-        if self._set(self.fmu.component, self._in, 3, self._iv) > 1 or self._step(self.fmu.component, t, h, 1) > 1:
+        c = self.fmu.component
+        if self._set(c, self._in, 3, self._iv) > 1:
+            raise RuntimeError(f"the damper refused its inputs at t = {t}")
+        if a_rate is not None:
+            self._der[0] = a_rate
+            if self._set_der(c, self._a_vr, 1, self._order1, self._der) > 1:
+                raise RuntimeError(f"the damper refused the input derivative at t = {t}")
+        if self._step(c, t, h, 1) > 1:
             raise RuntimeError(f"the damper refused a step at t = {t}")
         self.read()
+
+    def force_rate(self):
+        """d(force)/dt now, exact from the model (fmi2GetRealOutputDerivatives, order 1)."""
+        if self._get_der(self.fmu.component, self._f_vr, 1, self._order1, self._der) > 1:
+            raise RuntimeError("fmi2GetRealOutputDerivatives failed")
+        return self._der[0]
 
     def close(self):
         self.fmu.terminate()
@@ -162,10 +180,18 @@ class DamperPool:
         self.dampers = []
 
 
-def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_forces=None, pool=None):
+def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_forces=None, pool=None,
+             derivatives=False):
     """Co-simulate; ground(t) -> (a_g, v_g, x_g). floor_forces, if given, is an array of external
     forces on the floors [N] sampled every h/2 from t = 0 (the RK4 stage times). pool, if given,
-    a DamperPool that provides (and keeps) the FMU instances. Returns the time series."""
+    a DamperPool that provides (and keeps) the FMU instances. Returns the time series.
+
+    derivatives=False: Gauss-Seidel, first order: the building steps with each damper's
+    force.mean held, then each damper steps with its floor's motion at the step's end held.
+    derivatives=True: Jacobi with derivatives, second order: each damper gets its floor's motion
+    at the step's start and d(base.a)/dt = (F' - C A - K V)_floor / m_floor (F' from the
+    dampers' force rates and the external forces' slope over the step), and the building steps
+    with every damper's force extrapolated from its value and exact rate at the step's start."""
     b = cfg["building"]
     n = len(b["masses"])
     dampers = []
@@ -181,14 +207,27 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
     X, V = np.zeros(n), np.zeros(n)
     out = {"t": np.arange(steps + 1) * h, "X": np.zeros((steps + 1, n)), "A": np.zeros((steps + 1, n)),
            "F": np.zeros((steps + 1, len(dampers))), "E": np.zeros((steps + 1, len(dampers)))}
+    ext = (lambda i: floor_forces[i]) if floor_forces is not None else (lambda i: 0.0)  # noqa: E731
+    rates = [dp.force_rate() for dp in dampers] if derivatives else None
     for k in range(steps):
         t = k * h
-        F = np.zeros(n)
-        for dp in dampers:
-            F[dp.floor] += dp.force_mean if k else dp.force
+        F, dF = np.zeros(n), np.zeros(n)
+        for j, dp in enumerate(dampers):
+            F[dp.floor] += dp.force if (derivatives or not k) else dp.force_mean
+            if derivatives:
+                dF[dp.floor] += rates[j]
+        if derivatives and dampers:
+            ag, vg, xg = ground(t)
+            A0 = bld.accel(X, V, F + ext(2 * k), ag)
+            dext = (ext(2 * k + 2) - ext(2 * k)) / h
+            a_rate = bld.minv * (dF + dext - bld.C @ A0 - bld.K @ V)
+            for j, dp in enumerate(dampers):
+                i = dp.floor
+                dp.step(t, h, ag + A0[i], vg + V[i], xg + X[i], a_rate[i])
+                rates[j] = dp.force_rate()
+
         def rhs(tt, X_, V_, stage):
-            Fe = F if floor_forces is None else F + floor_forces[2 * k + stage]
-            return V_, bld.accel(X_, V_, Fe, ground(tt)[0])
+            return V_, bld.accel(X_, V_, F + dF * (tt - t) + ext(2 * k + stage), ground(tt)[0])
         # RK4 over the step with the dampers' forces held
         k1 = rhs(t, X, V, 0)
         k2 = rhs(t + h / 2, X + h / 2 * k1[0], V + h / 2 * k1[1], 1)
@@ -197,10 +236,15 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
         X = X + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
         V = V + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
         ag, vg, xg = ground(t + h)
-        A_rel = bld.accel(X, V, F if floor_forces is None else F + floor_forces[2 * k + 2], ag)
+        if derivatives:
+            F = np.zeros(n)
+            for dp in dampers:
+                F[dp.floor] += dp.force
+        A_rel = bld.accel(X, V, F + ext(2 * k + 2), ag)
         for j, dp in enumerate(dampers):
-            i = dp.floor
-            dp.step(t, h, ag + A_rel[i], vg + V[i], xg + X[i])
+            if not derivatives:
+                i = dp.floor
+                dp.step(t, h, ag + A_rel[i], vg + V[i], xg + X[i])
             out["F"][k + 1, j], out["E"][k + 1, j] = dp.force, dp.dissipated
         out["X"][k + 1], out["A"][k + 1] = X, ag + A_rel
     if pool is None:
@@ -227,6 +271,7 @@ def main(argv=None):
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     load, h = cfg["load"], cfg["coupling"]["step"]
+    derivs = bool(cfg["coupling"].get("derivatives", False))
     if load["kind"] == "harmonic":
         b = cfg["building"]
         w1 = Building(b["masses"], b["stiffnesses"], b["rayleigh"]).omega1
@@ -238,7 +283,8 @@ def main(argv=None):
             ground = lambda t, w=w: (-w * w * Ag * math.sin(w * t), w * Ag * math.cos(w * t), Ag * math.sin(w * t))  # noqa: E731
             peak = []
             for damped in (False, True):
-                s = simulate(cfg, unzipdir, md, ground, h, load["duration"], with_dampers=damped)
+                s = simulate(cfg, unzipdir, md, ground, h, load["duration"], with_dampers=damped,
+                             derivatives=derivs)
                 tail = s["t"] > load["duration"] - 20.0
                 peak.append(np.max(np.abs(s["X"][tail, -1])))
             rows.append((r, *peak))
@@ -267,7 +313,8 @@ def main(argv=None):
                                     load.get("coherence", 0.5), load.get("seed", 1))
         runs = {}
         for damped in tqdm((False, True), desc=load["kind"]):
-            runs[damped] = simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=damped, floor_forces=forces)
+            runs[damped] = simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=damped,
+                                   floor_forces=forces, derivatives=derivs)
         write_histories(out, load["kind"], runs[True], runs[False], plt)
     else:
         sys.exit(f"unknown load kind {load['kind']!r}: harmonic, record or wind")

@@ -88,7 +88,8 @@ def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool =
            "dampers": [{"floor": 1, "tanks": run["tanks"], "params": study.get("damper", {}).get("params", {})}]}
     w, a = run["frequency_ratio"] * run["omega_s"], run["ground_amplitude"]
     ground = lambda t: (-w * w * a * math.sin(w * t), w * a * math.cos(w * t), a * math.sin(w * t))  # noqa: E731
-    s = building.simulate(cfg, unzipdir, md, ground, rn["step"], rn["duration"], pool=None if fresh else pool)
+    s = building.simulate(cfg, unzipdir, md, ground, rn["step"], rn["duration"], pool=None if fresh else pool,
+                          derivatives=bool(rn.get("derivatives", False)))
     tail = s["t"] > rn["duration"] - rn["tail"]
     peak = float(np.max(np.abs(s["X"][tail, 0])))
     row = {k: run[k] for k in COLUMNS if k in run}
