@@ -54,21 +54,29 @@ class Building:
         return self.minv * (F - self.C @ V - self.K @ X) - ag
 
 
-def wind_forces(n_floors, dt, duration, force_rms, band, corner, coherence, seed):
-    """Band-limited wind-like random forces on the floors, sampled every dt over [0, duration].
+def wind_forces(n_floors, dt, n, force_rms, band, corner, coherence, seed):
+    """Band-limited wind-like random forces on the floors at t = 0, dt, ..., n dt.
 
     Each floor's force is a zero-mean Gaussian process with the one-sided spectrum
     S(f) ~ (1 + (f / corner)^2)^(-5/6) (the von Karman/Kaimal high-frequency roll-off of
-    along-wind turbulence) inside band = [f_lo, f_hi] Hz and nothing outside, scaled to the
-    floor's rms force [N]. Floors share a common part with weight `coherence` (0: independent,
-    1: fully correlated). Built by the spectral representation on the FFT grid (random phases,
-    deterministic amplitudes), so the rms over one period (the duration) is exact and the signal is
-    periodic in the duration. Returns (t, F) with F of shape (len(t), n_floors)."""
-    rng = np.random.default_rng(seed)
-    nfft = max(int(round(duration / dt)), 2)   # one period: the sample at `duration` repeats t = 0
-    f = np.fft.rfftfreq(nfft, dt)
+    along-wind turbulence) inside band = [f_lo, f_hi] Hz (0 < f_lo; the mean wind's static part
+    is not in it) and nothing outside, scaled to the floor's rms force [N]. Floors share a
+    common part with weight `coherence` in [0, 1] (0: independent, 1: fully correlated). Built by
+    the spectral representation on the FFT grid of period n dt (random phases; the spectrum's
+    shape is exact for each unit process, and for the floors when coherence is 0 or 1), each
+    floor scaled so that its rms over the period is exact; the sample at n dt repeats t = 0.
+    Returns (t, F) with F of shape (n + 1, n_floors)."""
     f_lo, f_hi = band
+    if not 0 < f_lo < f_hi:
+        raise ValueError(f"wind band {band} Hz: need 0 < f_lo < f_hi")
+    if not 0 <= coherence <= 1:
+        raise ValueError(f"wind coherence {coherence}: need 0 <= coherence <= 1")
+    rng = np.random.default_rng(seed)
+    nfft = max(int(n), 2)
+    f = np.fft.rfftfreq(nfft, dt)
     shape = np.where((f >= f_lo) & (f <= f_hi), (1 + (f / corner) ** 2) ** (-5 / 6), 0.0)
+    if nfft % 2 == 0:
+        shape[-1] = 0.0   # the Nyquist bin is real in irfft: a random phase would change its power
     if not np.any(shape > 0):
         raise ValueError(f"wind band {band} Hz holds no frequency of the {nfft * dt:.4g} s grid")
 
@@ -134,13 +142,21 @@ class Damper:
             raise RuntimeError("fmi2GetReal failed")
         self.force, self.force_mean, self.dissipated, self.x = self._ov[:]
 
-    def step(self, t, h, a, v, x, a_rate=None):
-        """fmi2DoStep from t by h with the floor's absolute motion at the step's start; a_rate, if
-        given, is d(base.a)/dt there (fmi2SetRealInputDerivatives, order 1)."""
+    def set_inputs(self, t, a, v, x):
+        """The floor's absolute acceleration, velocity and displacement (base.a, base.v, base.x)."""
         self._iv[:] = (a, v, x)
-        c = self.fmu.component
-        if self._set(c, self._in, 3, self._iv) > 1:
+        if self._set(self.fmu.component, self._in, 3, self._iv) > 1:
             raise RuntimeError(f"the damper refused its inputs at t = {t}")
+
+    def step(self, t, h, a, v, x):
+        """fmi2DoStep from t by h with these inputs held over the step."""
+        self.set_inputs(t, a, v, x)
+        self.step_with_rate(t, h, None)
+
+    def step_with_rate(self, t, h, a_rate):
+        """fmi2DoStep from t by h with the inputs already set; a_rate, if given, is d(base.a)/dt
+        at t (fmi2SetRealInputDerivatives, order 1)."""
+        c = self.fmu.component
         if a_rate is not None:
             self._der[0] = a_rate
             if self._set_der(c, self._a_vr, 1, self._order1, self._der) > 1:
@@ -208,23 +224,23 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
     out = {"t": np.arange(steps + 1) * h, "X": np.zeros((steps + 1, n)), "A": np.zeros((steps + 1, n)),
            "F": np.zeros((steps + 1, len(dampers))), "E": np.zeros((steps + 1, len(dampers)))}
     ext = (lambda i: floor_forces[i]) if floor_forces is not None else (lambda i: 0.0)  # noqa: E731
-    rates = [dp.force_rate() for dp in dampers] if derivatives else None
     for k in range(steps):
         t = k * h
         F, dF = np.zeros(n), np.zeros(n)
-        for j, dp in enumerate(dampers):
+        for dp in dampers:
             F[dp.floor] += dp.force if (derivatives or not k) else dp.force_mean
-            if derivatives:
-                dF[dp.floor] += rates[j]
         if derivatives and dampers:
             ag, vg, xg = ground(t)
             A0 = bld.accel(X, V, F + ext(2 * k), ag)
+            # the force rates depend on base.a: read them with this step's inputs set
+            for dp in dampers:
+                i = dp.floor
+                dp.set_inputs(t, ag + A0[i], vg + V[i], xg + X[i])
+                dF[i] += dp.force_rate()
             dext = (ext(2 * k + 2) - ext(2 * k)) / h
             a_rate = bld.minv * (dF + dext - bld.C @ A0 - bld.K @ V)
-            for j, dp in enumerate(dampers):
-                i = dp.floor
-                dp.step(t, h, ag + A0[i], vg + V[i], xg + X[i], a_rate[i])
-                rates[j] = dp.force_rate()
+            for dp in dampers:
+                dp.step_with_rate(t, h, a_rate[dp.floor])
 
         def rhs(tt, X_, V_, stage):
             return V_, bld.accel(X_, V_, F + dF * (tt - t) + ext(2 * k + stage), ground(tt)[0])
@@ -308,7 +324,9 @@ def main(argv=None):
         else:
             duration = load["duration"]
             ground = lambda t: (0.0, 0.0, 0.0)  # noqa: E731
-            _, forces = wind_forces(len(cfg["building"]["masses"]), h / 2, duration, load["force_rms"],
+            # on the RK4 stage times of the master's grid: 2 samples per communication step
+            _, forces = wind_forces(len(cfg["building"]["masses"]), h / 2, 2 * int(round(duration / h)),
+                                    load["force_rms"],
                                     load.get("band", [0.02, 5.0]), load.get("corner", 0.1),
                                     load.get("coherence", 0.5), load.get("seed", 1))
         runs = {}

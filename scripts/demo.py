@@ -139,8 +139,6 @@ def cosimulate(unzipdir, w, A_g, h, t_end, params=None, t_window=20.0, record=Fa
                     raise FMICallException("fmi2GetRealOutputDerivatives", st)
                 return der_val[0]
 
-            dF = force_rate()
-
         n = int(round(t_end / h))
         k_window = n - int(round(t_window / h))
         k_half = n - 2 * int(round(t_window / h))
@@ -167,7 +165,9 @@ def cosimulate(unzipdir, w, A_g, h, t_end, params=None, t_window=20.0, record=Fa
             if st > 1:
                 raise FMICallException("fmi2SetReal", st)
             if extrapolate:
-                # X'' = a_tank - a_g; a_tank' from the structure's equation
+                # the force's rate now, with this step's base.a set (it depends on it); then
+                # a_tank' from the structure's equation, X'' = a_tank - a_g
+                dF = force_rate()
                 der_val[0] = (dF - C_S * (a_abs + w2A * s) - K_S * V) / mass
                 st = setDer(comp, a_vr, 1, order1, der_val)
                 if st > 1:
@@ -181,7 +181,7 @@ def cosimulate(unzipdir, w, A_g, h, t_end, params=None, t_window=20.0, record=Fa
             if extrapolate:
                 # the liquid force over the step: its value and rate at t_k, extrapolated
                 F0, F1, Fm = F, F + h * dF, F + 0.5 * h * dF
-                F, dF = out_val[0], force_rate()
+                F = out_val[0]
             else:
                 # the step's mean liquid force (impulse / h), held
                 F, Fm = out_val[0], out_val[1]

@@ -94,7 +94,7 @@ def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool =
     peak = float(np.max(np.abs(s["X"][tail, 0])))
     row = {k: run[k] for k in COLUMNS if k in run}
     row.update(peak_displacement=peak, amplification=peak / a,
-               worker=f"{os.getpid()}/{threading.get_ident()}", instances=len(pool.dampers))
+               worker=f"{os.getpid()}/{threading.get_ident()}", instances=len(pool.dampers), error="")
     return row
 
 
@@ -108,10 +108,13 @@ def run_study(study: dict, fmu_path: Path, client=None, progress=True) -> tuple[
     from tqdm import tqdm
     bar = tqdm(total=len(runs), desc="runs", disable=not progress)
     t0 = time.perf_counter()
+    rows = [None] * len(runs)
     if client is None:
-        rows = []
-        for r in runs:
-            rows.append(run_one(fmu_bytes, digest, study, r))
+        for i, r in enumerate(runs):
+            try:
+                rows[i] = run_one(fmu_bytes, digest, study, r)
+            except Exception as e:   # one failed run must not lose the others
+                rows[i] = failed_row(r, e)
             bar.update()
     else:
         from distributed import as_completed
@@ -119,12 +122,23 @@ def run_study(study: dict, fmu_path: Path, client=None, progress=True) -> tuple[
         futures = client.map(run_one, [data] * len(runs), [digest] * len(runs), [study] * len(runs), runs,
                              pure=False)
         index = {f.key: i for i, f in enumerate(futures)}
-        rows = [None] * len(runs)
         for f in as_completed(futures):
-            rows[index[f.key]] = f.result()
+            i = index[f.key]
+            try:
+                rows[i] = f.result()
+            except Exception as e:
+                rows[i] = failed_row(runs[i], e)
             bar.update()
     bar.close()
     return rows, time.perf_counter() - t0
+
+
+def failed_row(run: dict, error: Exception) -> dict:
+    """A run that raised: its parameters, NaN results and the reason."""
+    row = {k: run[k] for k in COLUMNS if k in run}
+    row.update(peak_displacement=math.nan, amplification=math.nan, worker="", instances=0,
+               error=f"{type(error).__name__}: {error}".replace(",", ";").replace("\n", " "))
+    return row
 
 
 def connect(scheduler: str | None, workers: int):
@@ -154,7 +168,7 @@ def connect(scheduler: str | None, workers: int):
 
 
 def write_table(rows: list[dict], path: Path):
-    cols = COLUMNS + ["worker", "instances"]
+    cols = COLUMNS + ["worker", "instances", "error"]
     with open(path, "w") as fh:
         fh.write(",".join(cols) + "\n")
         for r in rows:
@@ -215,6 +229,10 @@ def main(argv=None):
     write_table(rows, out / "study.csv")
     heat_maps(rows, out / "study.png")
     where = "serial" if args.serial else (args.scheduler or f"LocalCluster, {args.workers} workers")
+    failed = [r for r in rows if r["error"]]
+    if failed:
+        print(f"{len(failed)} of {len(rows)} runs failed (NaN in the table, reason in its 'error' column); "
+              f"first: {failed[0]['error']}")
     print(f"{len(rows)} runs in {wall:.1f} s ({len(rows) / wall:.2f} runs/s, {where}); "
           f"{len({r['worker'] for r in rows})} worker threads, at most {max(r['instances'] for r in rows)} "
           f"FMU instance(s) each; wrote {out}/study.csv, study.png")

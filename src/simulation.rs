@@ -827,6 +827,14 @@ impl Simulation {
             tracker.set_state(&t)?;
         }
         sim.zeta = sim.config.zeta(sim.amplitude);
+        // The damping the last step used, where the model keeps it (the output derivatives
+        // read it before the next step).
+        let (zeta, omega_f) = (sim.zeta, sim.derived.omega_f);
+        match &mut sim.dynamics {
+            Dynamics::Nonlinear { model, .. } => model.c = 2.0 * zeta * omega_f,
+            Dynamics::Linear { modes } => modes.iter_mut().for_each(|m| m.0.zeta = zeta),
+            Dynamics::Slamming { mode, .. } => mode.0.zeta = zeta,
+        }
         Ok(sim)
     }
 
@@ -1065,6 +1073,58 @@ mod tests {
             "{r:?}"
         );
         assert_eq!(sim, before);
+    }
+
+    #[test]
+    fn a_restored_state_has_the_damping_of_its_last_step() {
+        // Tracked amplitude: the damping moves with every step, and the output derivatives read
+        // it from the model; a restored simulation must give the same ones as the original.
+        for model in [
+            ModelKind::Nonlinear,
+            ModelKind::Linear { modes: 2 },
+            ModelKind::SloshingSlamming(SlammingParams {
+                omega: 0.9,
+                restitution: 0.4,
+                clearance: 0.1,
+                mass_ratio: 0.01,
+            }),
+        ] {
+            let cfg = Config {
+                model,
+                amplitude: AmplitudeSource::Tracked {
+                    tau: 0.0,
+                    prior: 0.005,
+                },
+                ..config()
+            };
+            let (mut sim, _) = Simulation::new(cfg).expect("config");
+            let zeta0 = sim.zeta;
+            for k in 0..400 {
+                let t = f64::from(k) * 0.01;
+                let inputs = Inputs {
+                    a: 0.5 * (5.6 * t).sin(),
+                    v: -0.5 / 5.6 * (5.6 * t).cos(),
+                    ..Inputs::default()
+                };
+                sim.step(t, 0.01, &inputs).expect("step");
+            }
+            assert!(
+                (sim.zeta - zeta0).abs() > 1e-4 * zeta0,
+                "{model:?}: the damping moved"
+            );
+            let restored = Simulation::restore(cfg, &sim.snapshot()).expect("restore");
+            let inputs = Inputs {
+                a: 0.3,
+                ..Inputs::default()
+            };
+            for which in [Output::Force, Output::BaseShear] {
+                assert_eq!(
+                    restored.output_derivative(which, &inputs),
+                    sim.output_derivative(which, &inputs),
+                    "{model:?} {which:?}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -74,6 +74,20 @@ def slave_factory(model_description, unzipdir, variables):
         s.close()
 
 
+_LOGGER = None                                   # the one logger fmpy's proxy calls (see Slave)
+_LOG_ROUTES: dict[int, list] = {}                # componentEnvironment -> that Slave's messages
+
+
+def _route_log_message(env, instance, status, category, message):
+    try:
+        messages = _LOG_ROUTES.get(env or 0)
+        if messages is not None:
+            messages.append((int(status), (category or b"").decode("utf-8", "replace"),
+                             (message or b"").decode("utf-8", "replace")))
+    except Exception:  # never let an exception unwind into the FMU
+        pass
+
+
 class Slave:
     """One FMU instance driven through fmpy.fmi2.FMU2Slave."""
 
@@ -88,20 +102,24 @@ class Slave:
         self.vars = variables
         self.messages: list[tuple[int, str, str]] = []   # (status, category, message)
 
-        def logger(env, instance, status, category, message):
-            try:
-                self.messages.append((int(status), (category or b"").decode("utf-8", "replace"),
-                                      (message or b"").decode("utf-8", "replace")))
-            except Exception:  # never let an exception unwind into the FMU
-                pass
-
+        # fmpy's printf-formatting proxy (logging.so) keeps ONE global Python target for every
+        # instance in the process, whatever struct it was installed into: a per-instance Python
+        # logger would dangle there once its Slave is gone, and the next FMU that logs through
+        # fmpy's proxy (any FMU2Slave with the default callbacks) would crash the process. So the
+        # target is one module-level router that lives forever and dispatches on
+        # componentEnvironment.
+        global _LOGGER
+        if _LOGGER is None:
+            _LOGGER = fmi2CallbackLoggerTYPE(_route_log_message)
+        key = len(_LOG_ROUTES) + 1
+        _LOG_ROUTES[key] = self.messages
         cb = fmi2CallbackFunctions()
-        cb.logger = fmi2CallbackLoggerTYPE(logger)
+        cb.logger = _LOGGER
         cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        addLoggerProxy(ctypes.byref(cb))   # fmpy's printf-formatting proxy in front of `logger`
+        cb.componentEnvironment = key
+        addLoggerProxy(ctypes.byref(cb))   # the proxy in front of the router
         self._callbacks = cb              # keep alive as long as the instance
-        self._logger = logger
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
         self.fmu.instantiate(callbacks=cb, loggingOn=logging_on)

@@ -97,3 +97,25 @@ def toml(d: dict) -> str:
         return repr(v)
     return "".join(f"[{name}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in table.items())
                    for name, table in d.items())
+
+
+@pytest.mark.parametrize("where", ["serial", "dask"])
+def test_a_failed_run_is_reported_and_loses_nothing(fmu_path, reference, where):
+    """A run the FMU refuses (here a NaN ground amplitude: base.a = NaN) becomes a row with NaN
+    results and the reason; every other run is still there, with the numbers it has alone."""
+    study = {**STUDY, "study": {**STUDY["study"], "ground_amplitude": [1e-4, float("nan")]}}
+    client = cluster = None
+    if where == "dask":
+        client, cluster = sweep.connect(None, 1)
+    try:
+        rows, _ = sweep.run_study(study, fmu_path, client, progress=False)
+    finally:
+        if client is not None:
+            client.close()
+            cluster.close()
+    failed = [r for r in rows if r["error"]]
+    good = [r for r in rows if not r["error"]]
+    assert len(rows) == 24 and len(failed) == 12 and len(good) == 12
+    assert all(np.isnan(r["peak_displacement"]) and np.isnan(r["ground_amplitude"]) for r in failed)
+    assert all("refused" in r["error"] for r in failed), failed[0]["error"]
+    assert_same(good, reference)
