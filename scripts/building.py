@@ -242,8 +242,17 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
             for dp in dampers:
                 dp.step_with_rate(t, h, a_rate[dp.floor])
 
+        # the floor forces at the RK4 stage times t, t + h/2, t + h (dampers' forces extrapolated
+        # with their rates in derivative mode, held otherwise)
+        if derivatives:
+            Fs = [F + dF * (0.5 * h * j) + ext(2 * k + j) for j in range(3)]
+        elif floor_forces is not None:
+            Fs = [F + floor_forces[2 * k + j] for j in range(3)]
+        else:
+            Fs = [F, F, F]
+
         def rhs(tt, X_, V_, stage):
-            return V_, bld.accel(X_, V_, F + dF * (tt - t) + ext(2 * k + stage), ground(tt)[0])
+            return V_, bld.accel(X_, V_, Fs[stage], ground(tt)[0])
         # RK4 over the step with the dampers' forces held
         k1 = rhs(t, X, V, 0)
         k2 = rhs(t + h / 2, X + h / 2 * k1[0], V + h / 2 * k1[1], 1)
