@@ -39,6 +39,11 @@ pub trait Embedded<const N: usize>: Default {
     /// Order of the error estimate plus one: the step factor is err^(-1/ORDER).
     const ORDER: f64;
 
+    /// Below this error the step factor 0.9 err^(-1/ORDER) is past its cap of 5 for sure (a
+    /// margin under 0.18^ORDER): the usual case when the communication step is shorter than
+    /// the natural step, and it saves a libm pow per step.
+    const GROWS_FULLY_BELOW: f64 = 0.99 * powi_const(0.18, ceil_u32(Self::ORDER));
+
     /// Start of an interval at (t, y): f(t, y) into `f0` (a method may keep it, FSAL).
     fn begin<F: Rhs<N>>(&mut self, f: &F, t: f64, y: &[f64; N], f0: &mut [f64; N]);
 
@@ -59,6 +64,23 @@ pub trait Embedded<const N: usize>: Default {
 
     /// The last attempt was accepted.
     fn accepted(&mut self);
+}
+
+/// The smallest integer >= x >= 0, usable in constants.
+const fn ceil_u32(x: f64) -> u32 {
+    let n = x as u32;
+    if (n as f64) < x { n + 1 } else { n }
+}
+
+/// x^n, usable in constants.
+const fn powi_const(x: f64, n: u32) -> f64 {
+    let mut out = 1.0;
+    let mut k = 0;
+    while k < n {
+        out *= x;
+        k += 1;
+    }
+    out
 }
 
 /// An error-controlled integrator: an embedded method `M` under this module's step-size
@@ -208,7 +230,7 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
         if e <= 1.0 {
             stats.accepted += 1;
             method.accepted();
-            let fac = if e == 0.0 {
+            let fac = if e <= M::GROWS_FULLY_BELOW {
                 5.0
             } else {
                 (0.9 * e.powf(-1.0 / M::ORDER)).clamp(0.2, 5.0)
@@ -244,4 +266,34 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
     *y = z;
     *h_next = carried;
     Ok(stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::dop853::Dop853Stages;
+    use crate::solver::dopri5::DormandPrince;
+    use crate::solver::sdirk4::Sdirk4Stages;
+
+    #[test]
+    fn the_full_growth_shortcut_agrees_with_the_formula() {
+        // Below the shortcut's bound the step factor formula is capped at 5, for every method.
+        for (bound, order) in [
+            (<DormandPrince<2> as Embedded<2>>::GROWS_FULLY_BELOW, 5.0),
+            (<Dop853Stages<2> as Embedded<2>>::GROWS_FULLY_BELOW, 8.0),
+            (<Sdirk4Stages<2> as Embedded<2>>::GROWS_FULLY_BELOW, 4.0),
+        ] {
+            for e in [bound, 0.5 * bound, 1e-3 * bound, f64::MIN_POSITIVE] {
+                assert_eq!(
+                    (0.9 * e.powf(-1.0_f64 / order)).clamp(0.2, 5.0),
+                    5.0,
+                    "{order} {e}"
+                );
+            }
+            // and it starts just under where the cap does
+            assert!(bound > 0.98 * 0.18f64.powf(order), "{order}: {bound}");
+        }
+        assert_eq!(ceil_u32(4.0), 4);
+        assert_eq!(ceil_u32(4.5), 5);
+    }
 }
