@@ -857,18 +857,27 @@ impl Simulation {
 
     /// The output `which` now.
     pub fn output(&self, which: Output, inputs: &Inputs) -> f64 {
-        let modes = self.linear_modes();
-        let impact = self.impact();
-        let over_modes = |f: &dyn Fn(&Mode, &ModeState) -> f64| {
-            modes.iter().map(|(mode, m, s)| m * f(mode, s)).sum::<f64>()
-        };
-        let over_impact = |f: &dyn Fn(&SlamState) -> f64| impact.map_or(0.0, |(m, s)| m * f(s));
+        let m = self.derived.mass_slosh;
         let nonlinear = match &self.dynamics {
             Dynamics::Nonlinear { model, y, .. } => Some((model, y)),
             _ => None,
         };
-        let m = self.derived.mass_slosh;
+        // Sums over the linear modes and the impact mass, formed only where an output needs them.
+        let over_modes = |f: &dyn Fn(&Mode, &ModeState) -> f64| {
+            self.linear_modes()
+                .iter()
+                .map(|(mode, m, s)| m * f(mode, s))
+                .sum::<f64>()
+        };
+        let over_impact =
+            |f: &dyn Fn(&SlamState) -> f64| self.impact().map_or(0.0, |(m, s)| m * f(s));
         match which {
+            Output::X => nonlinear.map_or_else(|| self.linear_modes()[0].2.x, |(_, y)| y[state::X]),
+            Output::V => nonlinear.map_or_else(|| self.linear_modes()[0].2.v, |(_, y)| y[state::V]),
+            Output::Force => match nonlinear {
+                Some((model, y)) => m * model.tank_force(y[state::X], y[state::V]),
+                None => over_modes(&|mode, s| mode.tank_force(s)),
+            },
             Output::ForceMean => self
                 .last_mean_force
                 .unwrap_or_else(|| self.output(Output::Force, inputs)),
@@ -878,12 +887,6 @@ impl Simulation {
                     - self.derived.mass_inactive * inputs.a
                     - over_impact(&|s| if s.contact != 0 { inputs.a } else { 0.0 })
             }
-            Output::Force => match nonlinear {
-                Some((model, y)) => m * model.tank_force(y[state::X], y[state::V]),
-                None => over_modes(&|mode, s| mode.tank_force(s)),
-            },
-            Output::X => nonlinear.map_or_else(|| modes[0].2.x, |(_, y)| y[state::X]),
-            Output::V => nonlinear.map_or_else(|| modes[0].2.v, |(_, y)| y[state::V]),
             Output::EnergyInput => {
                 self.initial_energy
                     + nonlinear.map_or(0.0, |(_, y)| m * y[state::WORK_IN])
@@ -903,8 +906,8 @@ impl Simulation {
             }
             Output::Amplitude => self.amplitude,
             Output::Zeta => self.zeta,
-            Output::ImpactZ => impact.map_or(0.0, |(_, s)| s.z),
-            Output::Impacts => impact.map_or(0.0, |(_, s)| s.impacts as f64),
+            Output::ImpactZ => self.impact().map_or(0.0, |(_, s)| s.z),
+            Output::Impacts => self.impact().map_or(0.0, |(_, s)| s.impacts as f64),
         }
     }
 
