@@ -95,6 +95,12 @@ def wind_forces(n_floors, dt, n, force_rms, band, corner, coherence, seed):
     return np.arange(nfft + 1) * dt, F
 
 
+def harmonic_ground(w, amplitude):
+    """Ground motion x_g = amplitude sin(w t) as ground(t) -> (a_g, v_g, x_g)."""
+    return lambda t: (-w * w * amplitude * math.sin(w * t), w * amplitude * math.cos(w * t),
+                      amplitude * math.sin(w * t))
+
+
 def np_eig(K, m):
     """Eigenvalues of M^-1 K (ascending) for diagonal M."""
     s = 1 / np.sqrt(m)
@@ -224,11 +230,18 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
     out = {"t": np.arange(steps + 1) * h, "X": np.zeros((steps + 1, n)), "A": np.zeros((steps + 1, n)),
            "F": np.zeros((steps + 1, len(dampers))), "E": np.zeros((steps + 1, len(dampers)))}
     ext = (lambda i: floor_forces[i]) if floor_forces is not None else (lambda i: 0.0)  # noqa: E731
+
+    def on_floors(values):
+        """Per-damper values summed onto the dampers' floors."""
+        F = np.zeros(n)
+        for dp, v in zip(dampers, values):
+            F[dp.floor] += v
+        return F
+
     for k in range(steps):
         t = k * h
-        F, dF = np.zeros(n), np.zeros(n)
-        for dp in dampers:
-            F[dp.floor] += dp.force if (derivatives or not k) else dp.force_mean
+        F = on_floors(dp.force if (derivatives or not k) else dp.force_mean for dp in dampers)
+        dF = np.zeros(n)
         if derivatives and dampers:
             ag, vg, xg = ground(t)
             A0 = bld.accel(X, V, F + ext(2 * k), ag)
@@ -236,7 +249,7 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
             for dp in dampers:
                 i = dp.floor
                 dp.set_inputs(t, ag + A0[i], vg + V[i], xg + X[i])
-                dF[i] += dp.force_rate()
+            dF = on_floors(dp.force_rate() for dp in dampers)
             dext = (ext(2 * k + 2) - ext(2 * k)) / h
             a_rate = bld.minv * (dF + dext - bld.C @ A0 - bld.K @ V)
             for dp in dampers:
@@ -253,7 +266,7 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
 
         def rhs(tt, X_, V_, stage):
             return V_, bld.accel(X_, V_, Fs[stage], ground(tt)[0])
-        # RK4 over the step with the dampers' forces held
+        # RK4 over the step
         k1 = rhs(t, X, V, 0)
         k2 = rhs(t + h / 2, X + h / 2 * k1[0], V + h / 2 * k1[1], 1)
         k3 = rhs(t + h / 2, X + h / 2 * k2[0], V + h / 2 * k2[1], 1)
@@ -262,9 +275,7 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
         V = V + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
         ag, vg, xg = ground(t + h)
         if derivatives:
-            F = np.zeros(n)
-            for dp in dampers:
-                F[dp.floor] += dp.force
+            F = on_floors(dp.force for dp in dampers)
         A_rel = bld.accel(X, V, F + ext(2 * k + 2), ag)
         for j, dp in enumerate(dampers):
             if not derivatives:
@@ -305,7 +316,7 @@ def main(argv=None):
         rows = []
         for r in tqdm(ratios, desc="sweep"):
             w = r * w1
-            ground = lambda t, w=w: (-w * w * Ag * math.sin(w * t), w * Ag * math.cos(w * t), Ag * math.sin(w * t))  # noqa: E731
+            ground = harmonic_ground(w, Ag)
             peak = []
             for damped in (False, True):
                 s = simulate(cfg, unzipdir, md, ground, h, load["duration"], with_dampers=damped,

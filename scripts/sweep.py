@@ -87,15 +87,17 @@ def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool =
                         "rayleigh": [st["damping"], st["damping"]]},
            "dampers": [{"floor": 1, "tanks": run["tanks"], "params": study.get("damper", {}).get("params", {})}]}
     w, a = run["frequency_ratio"] * run["omega_s"], run["ground_amplitude"]
-    ground = lambda t: (-w * w * a * math.sin(w * t), w * a * math.cos(w * t), a * math.sin(w * t))  # noqa: E731
-    s = building.simulate(cfg, unzipdir, md, ground, rn["step"], rn["duration"], pool=None if fresh else pool,
+    s = building.simulate(cfg, unzipdir, md, building.harmonic_ground(w, a), rn["step"], rn["duration"], pool=None if fresh else pool,
                           derivatives=bool(rn.get("derivatives", False)))
     tail = s["t"] > rn["duration"] - rn["tail"]
     peak = float(np.max(np.abs(s["X"][tail, 0])))
-    row = {k: run[k] for k in COLUMNS if k in run}
-    row.update(peak_displacement=peak, amplification=peak / a,
-               worker=f"{os.getpid()}/{threading.get_ident()}", instances=len(pool.dampers), error="")
-    return row
+    return _row(run, peak_displacement=peak, amplification=peak / a,
+                worker=f"{os.getpid()}/{threading.get_ident()}", instances=len(pool.dampers), error="")
+
+
+def _row(run: dict, **results) -> dict:
+    """A table row: the run's parameters and its results."""
+    return {**{k: run[k] for k in COLUMNS if k in run}, **results}
 
 
 def run_study(study: dict, fmu_path: Path, client=None, progress=True) -> tuple[list[dict], float]:
@@ -135,10 +137,8 @@ def run_study(study: dict, fmu_path: Path, client=None, progress=True) -> tuple[
 
 def failed_row(run: dict, error: Exception) -> dict:
     """A run that raised: its parameters, NaN results and the reason."""
-    row = {k: run[k] for k in COLUMNS if k in run}
-    row.update(peak_displacement=math.nan, amplification=math.nan, worker="", instances=0,
-               error=f"{type(error).__name__}: {error}".replace(",", ";").replace("\n", " "))
-    return row
+    return _row(run, peak_displacement=math.nan, amplification=math.nan, worker="", instances=0,
+                error=f"{type(error).__name__}: {error}".replace(",", ";").replace("\n", " "))
 
 
 def connect(scheduler: str | None, workers: int):

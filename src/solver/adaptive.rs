@@ -39,10 +39,10 @@ pub trait Embedded<const N: usize>: Default {
     /// Order of the error estimate plus one: the step factor is err^(-1/ORDER).
     const ORDER: f64;
 
-    /// Below this error the step factor 0.9 err^(-1/ORDER) is past its cap of 5 for sure (a
-    /// margin under 0.18^ORDER): the usual case when the communication step is shorter than
-    /// the natural step, and it saves a libm pow per step.
-    const GROWS_FULLY_BELOW: f64 = 0.99 * powi_const(0.18, ceil_u32(Self::ORDER));
+    /// Below this error the step factor SAFETY err^(-1/ORDER) is past its cap MAX_GROWTH for
+    /// sure (a margin under (SAFETY/MAX_GROWTH)^ORDER): the usual case when the communication
+    /// step is shorter than the natural step, and it saves a libm pow per step.
+    const GROWS_FULLY_BELOW: f64 = 0.99 * powi_const(SAFETY / MAX_GROWTH, ceil_u32(Self::ORDER));
 
     /// Start of an interval at (t, y): f(t, y) into `f0` (a method may keep it, FSAL).
     fn begin<F: Rhs<N>>(&mut self, f: &F, t: f64, y: &[f64; N], f0: &mut [f64; N]);
@@ -65,6 +65,12 @@ pub trait Embedded<const N: usize>: Default {
     /// The last attempt was accepted.
     fn accepted(&mut self);
 }
+
+/// The step factor after a step with error norm e is SAFETY e^(-1/ORDER), within
+/// [MIN_SHRINK, MAX_GROWTH] (and at most 1 right after a rejection).
+const SAFETY: f64 = 0.9;
+const MIN_SHRINK: f64 = 0.2;
+const MAX_GROWTH: f64 = 5.0;
 
 /// The smallest integer >= x >= 0, usable in constants.
 const fn ceil_u32(x: f64) -> u32 {
@@ -231,9 +237,9 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
             stats.accepted += 1;
             method.accepted();
             let fac = if e <= M::GROWS_FULLY_BELOW {
-                5.0
+                MAX_GROWTH
             } else {
-                (0.9 * e.powf(-1.0 / M::ORDER)).clamp(0.2, 5.0)
+                (SAFETY * e.powf(-1.0 / M::ORDER)).clamp(MIN_SHRINK, MAX_GROWTH)
             };
             let fac = if just_rejected { fac.min(1.0) } else { fac };
             just_rejected = false;
@@ -249,7 +255,7 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
             stats.rejected += 1;
             just_rejected = true;
             let fac = if e.is_finite() {
-                (0.9 * e.powf(-1.0 / M::ORDER)).clamp(0.2, 1.0)
+                (SAFETY * e.powf(-1.0 / M::ORDER)).clamp(MIN_SHRINK, 1.0)
             } else {
                 0.25
             };

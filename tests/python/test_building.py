@@ -41,7 +41,7 @@ def test_cosimulation_converges_to_the_monolithic_solution(fmu_path, model_descr
     Ag = 2e-4
     n_floors = len(b["masses"])
     if load == "ground":
-        ground = lambda t: (-w * w * Ag * math.sin(w * t), w * Ag * math.cos(w * t), Ag * math.sin(w * t))  # noqa: E731
+        ground = building.harmonic_ground(w, Ag)
         wind = lambda t: np.zeros(n_floors)  # noqa: E731
     else:
         ground = lambda t: (0.0, 0.0, 0.0)  # noqa: E731

@@ -34,6 +34,8 @@ from libcosimpy.CosimObserver import CosimObserver
 from libcosimpy.CosimSlave import CosimLocalSlave
 from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 
+from conftest import MODELS_APART
+
 log_output_level(CosimLogLevel.WARNING)   # libcosim traces every FMI call otherwise
 
 DT = 0.01
@@ -178,10 +180,6 @@ def test_comparison_detects_a_different_input(fmu_path, variables, slave_factory
     assert all(v > 100 * RTOL for v in d.values()), d
 
 
-# parameters that make the four models differ in this scene: the S^2 model's mass exchange
-# (Omega = 1 would make it the linear model until an impact), and an Auto threshold at which it
-# steps linearly part of the time (at the default it matches Nonlinear to ~1e-14)
-DISTINCT = {"slamming.Omega": 0.9, "auto.threshold": 1e-2}
 
 
 @pytest.mark.parametrize("model", [1, 2, 3, 4], ids=["Linear", "Nonlinear", "SloshingSlamming", "Auto"])
@@ -191,7 +189,7 @@ def test_every_option_reachable_from_libcosim_through_the_integer_aliases(fmu_pa
     model_id = m, damping_id = 1 (Constant) must match fmpy setting the enumerations
     themselves (model = m, damping = 1)."""
     a = base_acceleration()
-    reals = {**SCENE_REALS, **DISTINCT}
+    reals = {**SCENE_REALS, **MODELS_APART}
     fm = {m: run_fmpy(slave_factory, a, reals, {"model": m, "damping": 1}) for m in (1, 2, 3, 4)}
     lc = run_libcosim(fmu_path, variables, a, reals, {"model_id": model, "damping_id": 1})
     d = compare(lc, fm[model])

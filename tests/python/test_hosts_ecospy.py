@@ -65,6 +65,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import MODELS_APART
+
 
 def _load_tbb():
     """libecosc.so's libtbb.so.12: from the pinned `tbb` wheel (<venv>/lib), else the system."""
@@ -320,10 +322,7 @@ def test_ecos_cannot_set_enumerations(fmu_path):
         ss.free()
 
 
-# parameters that make the four models differ in this scene: the S^2 model's mass exchange
-# (Omega = 1 would make it the linear model until an impact), and an Auto threshold at which it
-# steps linearly part of the time (at the default it matches Nonlinear to ~1e-14)
-DISTINCT = {"zeta": 0.02, "slamming.Omega": 0.9, "auto.threshold": 1e-2}
+DISTINCT = {"zeta": 0.02, **MODELS_APART}
 
 
 @pytest.mark.parametrize("model", [1, 2, 3, 4], ids=["Linear", "Nonlinear", "SloshingSlamming", "Auto"])
