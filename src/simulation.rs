@@ -856,6 +856,7 @@ impl Simulation {
     }
 
     /// The output `which` now.
+    #[inline]
     pub fn output(&self, which: Output, inputs: &Inputs) -> f64 {
         let m = self.derived.mass_slosh;
         let nonlinear = match &self.dynamics {

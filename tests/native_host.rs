@@ -285,6 +285,16 @@ fn bad_values_are_refused_logged_and_change_nothing() {
             "unknown value reference (get)",
         );
         expect(
+            inst.get_real(vr::TANKS).0,
+            ERROR,
+            "Real getter on an Integer",
+        );
+        expect(
+            inst.get_real(vr::MODEL).0,
+            ERROR,
+            "Real getter on an Enumeration",
+        );
+        expect(
             inst.set_real(vr::ETA, 3.0),
             ERROR,
             "fixed parameter after initialisation",

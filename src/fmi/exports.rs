@@ -51,6 +51,7 @@ fn guard(
 }
 
 /// A host array of `n` elements; `n` = 0 accepts a null pointer.
+#[inline(always)]
 unsafe fn host_slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Result<&'a [T], Refusal> {
     if n == 0 {
         return Ok(&[]);
@@ -65,6 +66,7 @@ unsafe fn host_slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Result<&'a [
 }
 
 /// A host output array of `n` elements.
+#[inline(always)]
 unsafe fn host_slice_mut<'a, T>(ptr: *mut T, n: usize, what: &str) -> Result<&'a mut [T], Refusal> {
     if n == 0 {
         return Ok(&mut []);
@@ -428,11 +430,10 @@ pub unsafe extern "C" fn fmi2GetStatus(
         inst.require(allow::STATUS, "fmi2GetStatus")?;
         // SAFETY: host output scalar.
         unsafe { host_ref(value, "fmi2GetStatus: value")? };
-        Err(Refusal {
-            status: Status::Discard,
-            message: "fmi2GetStatus: no status is pending (fmi2DoStep never returns fmi2Pending)"
-                .into(),
-        })
+        Err(Refusal::new(
+            Status::Discard,
+            "fmi2GetStatus: no status is pending (fmi2DoStep never returns fmi2Pending)",
+        ))
     })
 }
 
@@ -447,12 +448,12 @@ pub unsafe extern "C" fn fmi2GetRealStatus(
         // SAFETY: host output scalar.
         let out = unsafe { host_ref(value, "fmi2GetRealStatus: value")? };
         if s != fmi2StatusKind_fmi2LastSuccessfulTime {
-            return Err(Refusal {
-                status: Status::Discard,
-                message: format!(
+            return Err(Refusal::new(
+                Status::Discard,
+                format!(
                     "fmi2GetRealStatus: status kind {s} has no Real value (only fmi2LastSuccessfulTime)"
                 ),
-            });
+            ));
         }
         *out = time;
         Ok(Status::Ok)
@@ -469,10 +470,10 @@ pub unsafe extern "C" fn fmi2GetIntegerStatus(
         inst.require(allow::STATUS, "fmi2GetIntegerStatus")?;
         // SAFETY: host output scalar.
         unsafe { host_ref(value, "fmi2GetIntegerStatus: value")? };
-        Err(Refusal {
-            status: Status::Discard,
-            message: format!("fmi2GetIntegerStatus: status kind {s} has no Integer value"),
-        })
+        Err(Refusal::new(
+            Status::Discard,
+            format!("fmi2GetIntegerStatus: status kind {s} has no Integer value"),
+        ))
     })
 }
 
@@ -487,12 +488,12 @@ pub unsafe extern "C" fn fmi2GetBooleanStatus(
         // SAFETY: host output scalar.
         let out = unsafe { host_ref(value, "fmi2GetBooleanStatus: value")? };
         if s != fmi2StatusKind_fmi2Terminated {
-            return Err(Refusal {
-                status: Status::Discard,
-                message: format!(
+            return Err(Refusal::new(
+                Status::Discard,
+                format!(
                     "fmi2GetBooleanStatus: status kind {s} has no Boolean value (only fmi2Terminated)"
                 ),
-            });
+            ));
         }
         // The FMU never asks the master to end the simulation.
         *out = 0;
@@ -510,10 +511,10 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
         inst.require(allow::STATUS, "fmi2GetStringStatus")?;
         // SAFETY: host output scalar.
         unsafe { host_ref(value, "fmi2GetStringStatus: value")? };
-        Err(Refusal {
-            status: Status::Discard,
-            message: format!("fmi2GetStringStatus: status kind {s}: nothing is pending"),
-        })
+        Err(Refusal::new(
+            Status::Discard,
+            format!("fmi2GetStringStatus: status kind {s}: nothing is pending"),
+        ))
     })
 }
 

@@ -4,10 +4,10 @@
 use std::ffi::CString;
 
 use super::logger::Logger;
-use super::params::{Values, derived_value, output_of};
+use super::params::{Source, Values, derived_value, output_of, source_of};
 use super::snapshot::Saved;
 use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, index_of, vr};
-use crate::simulation::{Simulation, StepError};
+use crate::simulation::{Inputs, Output, Simulation, StepError};
 use crate::solver::SolveError;
 
 /// fmi2Status, as a Rust enum.
@@ -25,16 +25,25 @@ pub enum Status {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Refusal {
     pub status: Status,
-    pub message: String,
+    /// Boxed so that a refusal is two words: every call's result then comes back in
+    /// registers, not through memory.
+    #[allow(clippy::box_collection)] // the point: one word, not three
+    pub message: Box<String>,
+}
+
+impl Refusal {
+    pub fn new(status: Status, message: impl Into<String>) -> Self {
+        Refusal {
+            status,
+            message: Box::new(message.into()),
+        }
+    }
 }
 
 pub type Reply = Result<Status, Refusal>;
 
 pub fn refuse(message: impl Into<String>) -> Refusal {
-    Refusal {
-        status: Status::Error,
-        message: message.into(),
-    }
+    Refusal::new(Status::Error, message)
 }
 
 /// States of the FMI 2.0 Co-Simulation state machine this FMU can be in (it never runs
@@ -393,6 +402,7 @@ impl Instance {
     }
 
     /// Values of the variables `vrs` of type `ty` (integers as f64), handed to `put` by position.
+    #[inline(always)]
     pub fn get(
         &self,
         vrs: &[u32],
@@ -401,57 +411,79 @@ impl Instance {
         mut put: impl FnMut(usize, f64),
     ) -> Reply {
         self.require(allow::GET, function)?;
-        let mut provisional = None;
         let inputs = self.values.inputs(self.a_derivatives);
         for (k, &r) in vrs.iter().enumerate() {
-            let (index, var) = Self::typed_variable(r, ty, function)?;
-            let no_value = || Self::no_value(var, function);
-            let value = match var.causality {
-                Causality::Parameter | Causality::Input | Causality::Local => self.values.at(index),
-                Causality::CalculatedParameter => {
+            let value = match source_of(r, ty) {
+                Source::Stored(index) => self.values.at(index),
+                Source::Output(which) => match &self.sim {
+                    Some(sim) => sim.output(which, &inputs),
+                    None => self.output_before_init(which, &inputs)?,
+                },
+                Source::Derived => {
                     let derived = match &self.sim {
                         Some(sim) => sim.derived(),
                         None => self.values.config(None, false).derived(),
                     };
-                    derived_value(r, &derived).ok_or_else(no_value)?
+                    derived_value(r, &derived).ok_or_else(|| Self::no_value(r, function))?
                 }
-                Causality::Output => {
-                    let which = output_of(r).ok_or_else(no_value)?;
-                    match &self.sim {
-                        Some(sim) => sim.output(which, &inputs),
-                        None => self.simulation(&mut provisional)?.output(which, &inputs),
-                    }
+                Source::NoValue(_) => return Err(Self::no_value(r, function)),
+                Source::WrongType(index) => {
+                    return Err(Self::wrong_type(r, &VARIABLES[index], function));
                 }
+                Source::Unknown => return Err(Self::unknown(r, function)),
             };
             put(k, value);
         }
         Ok(Status::Ok)
     }
 
+    /// An output before the simulation exists: from the simulation the values would start.
     #[cold]
-    fn no_value(var: &Variable, function: &str) -> Refusal {
-        refuse(format!("{function}: '{}' has no value", var.name))
+    #[inline(never)]
+    fn output_before_init(&self, which: Output, inputs: &Inputs) -> Result<f64, Refusal> {
+        let mut provisional = None;
+        Ok(self.simulation(&mut provisional)?.output(which, inputs))
+    }
+
+    #[cold]
+    fn no_value(vr: u32, function: &str) -> Refusal {
+        let name = index_of(vr).map_or("?", |i| VARIABLES[i].name);
+        refuse(format!("{function}: '{name}' has no value"))
     }
 
     /// Set the variables `vrs` of type `ty`: all are checked before any is changed.
+    #[inline(always)]
     pub fn set(&mut self, vrs: &[u32], values: &[f64], ty: VarType, function: &str) -> Reply {
         self.require(allow::SET, function)?;
+        // One variable (an input per step, the usual call): checked and set in one pass.
+        if let ([r], [value]) = (vrs, values) {
+            let index = self.check_set(*r, *value, ty, function)?;
+            self.put(*r, index, *value);
+            return Ok(Status::Ok);
+        }
         for (&r, &value) in vrs.iter().zip(values) {
             self.check_set(r, value, ty, function)?;
         }
         for (&r, &value) in vrs.iter().zip(values) {
             if let Some(index) = index_of(r) {
-                self.values.set_at(index, value);
-            }
-            if r == vr::SOLVER_TOLERANCE {
-                self.user_tolerance = true;
+                self.put(r, index, value);
             }
         }
         Ok(Status::Ok)
     }
 
-    fn check_set(&self, r: u32, value: f64, ty: VarType, function: &str) -> Result<(), Refusal> {
-        let (_, var) = Self::typed_variable(r, ty, function)?;
+    #[inline]
+    fn put(&mut self, r: u32, index: usize, value: f64) {
+        self.values.set_at(index, value);
+        if r == vr::SOLVER_TOLERANCE {
+            self.user_tolerance = true;
+        }
+    }
+
+    /// The position in the values of the variable `r`, if `value` may be set there now.
+    #[inline(always)]
+    fn check_set(&self, r: u32, value: f64, ty: VarType, function: &str) -> Result<usize, Refusal> {
+        let (index, var) = Self::typed_variable(r, ty, function)?;
         match var.causality {
             Causality::Parameter => {
                 let before_init =
@@ -474,7 +506,7 @@ impl Instance {
         if let Some(reason) = var.reject(value) {
             return Err(refuse(format!("{function}: {reason}")));
         }
-        Ok(())
+        Ok(index)
     }
 
     /// fmi2SetRealInputDerivatives: derivatives of Real inputs for the next step. base.a's are
@@ -539,6 +571,7 @@ impl Instance {
         Ok(Status::Ok)
     }
 
+    #[inline]
     pub fn do_step(&mut self, t: f64, h: f64) -> Reply {
         self.require(allow::STEP_COMPLETE, "fmi2DoStep")?;
         if !(h.is_finite() && h > 0.0) {
@@ -589,10 +622,10 @@ impl Instance {
                 } else {
                     " The state is left at the start of the step."
                 };
-                Err(Refusal {
+                Err(Refusal::new(
                     status,
-                    message: format!("fmi2DoStep from t = {t} by {h}: {e}.{hint}"),
-                })
+                    format!("fmi2DoStep from t = {t} by {h}: {e}.{hint}"),
+                ))
             }
         }
     }
@@ -642,7 +675,7 @@ impl Instance {
 
     fn restored(bytes: &[u8]) -> Result<Restored, Refusal> {
         let bad = |why: String| refuse(format!("the FMU state is not usable: {why}"));
-        let s = Saved::decode(bytes).map_err(|r| bad(r.message))?;
+        let s = Saved::decode(bytes).map_err(|r| bad(*r.message))?;
         let phase = match s.phase {
             0 => Phase::Instantiated,
             1 => Phase::InitializationMode,

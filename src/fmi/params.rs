@@ -1,7 +1,7 @@
 //! From the variable values the host set to the physics configuration. The only place that
 //! maps FMI variable names onto the simulation's inputs and outputs.
 
-use super::vars::{VARIABLES, index_of, vr};
+use super::vars::{Causality, VARIABLES, VR_INDEX, VarType, index_of, vr};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::simulation::{
@@ -11,17 +11,25 @@ use crate::simulation::{
 
 /// Values of all variables, in the order of `VARIABLES` (integers and enumerations as f64).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Values(Vec<f64>);
+pub struct Values([f64; VARIABLES.len()]);
+
+/// Position in `VARIABLES` of a variable known at compile time (the build fails if `vr` names
+/// none): the inputs, read on every step, then cost one load.
+const fn slot(vr: u32) -> usize {
+    let i = VR_INDEX[vr as usize];
+    assert!(i >= 0 && (i as usize) < VARIABLES.len());
+    i as usize
+}
+const BASE_A: usize = slot(vr::BASE_A);
+const BASE_V: usize = slot(vr::BASE_V);
+const BASE_X: usize = slot(vr::BASE_X);
 
 impl Values {
     /// Start values from the model description (NaN where a variable has none).
     pub fn start() -> Self {
-        Values(
-            VARIABLES
-                .iter()
-                .map(|v| v.start.unwrap_or(f64::NAN))
-                .collect(),
-        )
+        Values(std::array::from_fn(|i| {
+            VARIABLES[i].start.unwrap_or(f64::NAN)
+        }))
     }
 
     /// Values checked one by one against the model description (finite, in range, an
@@ -70,9 +78,9 @@ impl Values {
     /// The inputs, with the derivatives of base.a the host set for the coming step.
     pub fn inputs(&self, a_derivatives: [f64; 2]) -> Inputs {
         Inputs {
-            a: self.get(vr::BASE_A),
-            v: self.get(vr::BASE_V),
-            x: self.get(vr::BASE_X),
+            a: self.0[BASE_A],
+            v: self.0[BASE_V],
+            x: self.0[BASE_X],
             a_derivatives,
         }
     }
@@ -175,8 +183,71 @@ pub fn derived_value(vr: u32, derived: &Derived) -> Option<f64> {
     })
 }
 
+/// Where a get of the variable `vr` as type `ty` finds its value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Source {
+    /// No variable has this value reference.
+    Unknown,
+    /// The variable at this position in `VARIABLES` is of another type.
+    WrongType(usize),
+    /// The variable at this position has no value (a calculated variable nothing computes).
+    NoValue(usize),
+    /// A value the host set or a start value, at this position in `VARIABLES`.
+    Stored(usize),
+    /// A calculated parameter, from the configuration ([`derived_value`]).
+    Derived,
+    /// A simulation output.
+    Output(Output),
+}
+
+/// Where `vr`, read as type `ty`, comes from; Integer reads Enumeration variables too. A const
+/// fn: the table for Real, read on every step, is built by the compiler.
+pub const fn source(vr: u32, ty: VarType) -> Source {
+    let index = match index_of(vr) {
+        Some(i) => i,
+        None => return Source::Unknown,
+    };
+    let var = &VARIABLES[index];
+    let same = var.ty as u8 == ty as u8
+        || (matches!(ty, VarType::Integer) && matches!(var.ty, VarType::Enumeration));
+    if !same {
+        return Source::WrongType(index);
+    }
+    match var.causality {
+        Causality::Parameter | Causality::Input | Causality::Local => Source::Stored(index),
+        Causality::CalculatedParameter => Source::Derived,
+        Causality::Output => match output_of(vr) {
+            Some(which) => Source::Output(which),
+            None => Source::NoValue(index),
+        },
+    }
+}
+
+/// [`source`] for every value reference, read as Real.
+pub const REAL_SOURCES: [Source; VR_INDEX.len()] = {
+    let mut table = [Source::Unknown; VR_INDEX.len()];
+    let mut vr = 0;
+    while vr < table.len() {
+        table[vr] = source(vr as u32, VarType::Real);
+        vr += 1;
+    }
+    table
+};
+
+/// [`source`], from the table for Real.
+#[inline(always)]
+pub fn source_of(vr: u32, ty: VarType) -> Source {
+    match ty {
+        VarType::Real => REAL_SOURCES
+            .get(vr as usize)
+            .copied()
+            .unwrap_or(Source::Unknown),
+        _ => source(vr, ty),
+    }
+}
+
 /// The simulation output an output variable shows, by value reference.
-pub fn output_of(vr: u32) -> Option<Output> {
+pub const fn output_of(vr: u32) -> Option<Output> {
     Some(match vr {
         vr::FORCE => Output::Force,
         vr::FORCE_MEAN => Output::ForceMean,

@@ -46,14 +46,29 @@ pub struct Variable {
 include!(concat!(env!("OUT_DIR"), "/model_description.rs"));
 
 /// Position in [`VARIABLES`] of a value reference, if it names a variable.
-pub fn index_of(vr: u32) -> Option<usize> {
-    let i = *VR_INDEX.get(vr as usize)?;
-    usize::try_from(i).ok()
+pub const fn index_of(vr: u32) -> Option<usize> {
+    if vr as usize >= VR_INDEX.len() {
+        return None;
+    }
+    let i = VR_INDEX[vr as usize];
+    if i < 0 { None } else { Some(i as usize) }
 }
 
 impl Variable {
     /// Why `value` is not acceptable for this variable, if it is not.
+    #[inline]
     pub fn reject(&self, value: f64) -> Option<String> {
+        // The common case, a finite Real within its bounds, decided inline; any other goes
+        // to the full check, which also words the reason.
+        let within = value.is_finite()
+            && self.ty != VarType::Enumeration
+            && self.min.is_none_or(|min| value >= min)
+            && self.max.is_none_or(|max| value <= max);
+        if within { None } else { self.reason(value) }
+    }
+
+    #[cold]
+    fn reason(&self, value: f64) -> Option<String> {
         if !value.is_finite() {
             return Some(format!(
                 "'{}' cannot be set to {value}: the value must be finite",
