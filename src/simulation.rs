@@ -330,6 +330,97 @@ fn advance_mode(
     (next, impulse)
 }
 
+/// model = Auto: the nonlinear state advanced by the exact linear solution, if the hardening
+/// phi |2x/a|^(2eta-2) stays below `threshold` over the whole step (Eq 2.11 is then linear to
+/// that tolerance and its exact solution is cheaper than any integrator); None if it may not.
+/// The bound on |x| over the step: the free amplitude now, plus twice the static deflection
+/// and the growth of one step under the largest base acceleration of the step.
+#[inline(never)]
+fn linear_step(
+    model: &NonlinearTld,
+    threshold: f64,
+    mode: &mut Mode,
+    zeta: f64,
+    y: &[f64; state::DIM],
+    h: f64,
+    base: &BaseAcceleration,
+) -> Option<[f64; state::DIM]> {
+    let omega_f = mode.omega;
+    let (x, v) = (y[state::X], y[state::V]);
+    let a_max = base.a[0].abs() + h * (base.a[1].abs() + 0.5 * h * base.a[2].abs());
+    let bound =
+        (x * x + (v / omega_f).powi(2)).sqrt() + a_max * (2.0 / (omega_f * omega_f) + h / omega_f);
+    if model.stiffness.hardening(bound) >= threshold {
+        return None;
+    }
+    mode.zeta = zeta;
+    let mut s = ModeState {
+        x,
+        v,
+        work_in: y[state::WORK_IN],
+        dissipated: y[state::DISSIPATED],
+    };
+    mode.advance(&mut s, h, base);
+    Some([s.x, s.v, s.work_in, s.dissipated])
+}
+
+/// model = Linear: every mode advanced exactly; the statistics of the step and the impulse of
+/// the modes' forces on the tank. Exact propagation cannot fail; only the fundamental mode can
+/// run away (the higher ones respond less), so it is checked before anything changes.
+#[inline(never)]
+fn step_linear(
+    modes: &mut [(Mode, f64, ModeState)],
+    zeta: f64,
+    h: f64,
+    base: &BaseAcceleration,
+    limit: f64,
+) -> Result<(SolveStats, f64), StepError> {
+    let (first, mut impulse) = advance_mode(&modes[0], zeta, h, base);
+    check_runaway(first.2.x, limit)?;
+    modes[0] = first;
+    for mode in modes.iter_mut().skip(1) {
+        let (next, i) = advance_mode(mode, zeta, h, base);
+        *mode = next;
+        impulse += i;
+    }
+    Ok((
+        SolveStats {
+            accepted: 1,
+            ..SolveStats::default()
+        },
+        impulse,
+    ))
+}
+
+/// model = SloshingSlamming: the sloshing mode exactly, the impact mass event by event.
+#[inline(never)]
+fn step_slamming(
+    mode: &mut (Mode, f64, ModeState),
+    impact: &mut (Slamming, f64, SlamState),
+    zeta: f64,
+    h: f64,
+    base: &BaseAcceleration,
+    limit: f64,
+) -> Result<(SolveStats, f64), StepError> {
+    let (sloshing, slosh_impulse) = advance_mode(mode, zeta, h, base);
+    check_runaway(sloshing.2.x, limit)?;
+    let mut slam = impact.2;
+    let per_mass = impact
+        .0
+        .advance(&mut slam, h, base)
+        .map_err(StepError::Chattering)?;
+    let impulse = slosh_impulse + impact.1 * per_mass;
+    *mode = sloshing;
+    impact.2 = slam;
+    Ok((
+        SolveStats {
+            accepted: 1,
+            ..SolveStats::default()
+        },
+        impulse,
+    ))
+}
+
 /// Refuse a step whose sloshing displacement left any physical range.
 fn check_runaway(x: f64, limit: f64) -> Result<(), StepError> {
     if x.is_nan() || x.abs() > limit {
@@ -561,15 +652,11 @@ impl Simulation {
     /// from `inputs` (held when the derivatives are 0). All or nothing: on error the simulation
     /// is unchanged.
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<SolveStats, StepError> {
-        let mut zeta = self.zeta;
-        let mut tracker = None;
-        if let Some(tr) = &self.tracker {
-            // Only a tracked amplitude moves the damping; a fixed one was applied in new().
-            let mut tr = tr.clone();
-            tr.update(h, inputs.a, inputs.v);
-            zeta = self.config.zeta(tr.estimate());
-            tracker = Some(tr);
-        }
+        // Only a tracked amplitude moves the damping; a fixed one was applied in new().
+        let (zeta, tracker) = match &self.tracker {
+            None => (self.zeta, None),
+            Some(tr) => self.track(tr, h, inputs),
+        };
         let [a1, a2] = inputs.a_derivatives;
         // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
         // input, and (t + h) - t is not h in floating point (at t = 3600 s and h = 1 ms, a
@@ -602,38 +689,22 @@ impl Simulation {
                 model.base.t0 = 0.0;
                 model.base.a = [inputs.a, a1, a2];
                 let mut next = *y;
-                // model = Auto: while the hardening phi |2x/a|^(2eta-2) stays below the
-                // tolerance over the whole step, Eq 2.11 is linear to that tolerance and its
-                // exact solution is cheaper than any integrator. The bound on |x| over the step:
-                // the free amplitude now, plus twice the static deflection and the growth of one
-                // step under the largest base acceleration of the step.
-                if let Some((threshold, mode)) = linear_below.as_mut() {
-                    let (x, v) = (y[state::X], y[state::V]);
-                    let a_max = base.a[0].abs() + h * (base.a[1].abs() + 0.5 * h * base.a[2].abs());
-                    let bound = (x * x + (v / omega_f).powi(2)).sqrt()
-                        + a_max * (2.0 / (omega_f * omega_f) + h / omega_f);
-                    if model.stiffness.hardening(bound) < *threshold {
-                        mode.zeta = zeta;
-                        let mut s = ModeState {
-                            x,
-                            v,
-                            work_in: y[state::WORK_IN],
-                            dissipated: y[state::DISSIPATED],
-                        };
-                        mode.advance(&mut s, h, &base);
-                        next = [s.x, s.v, s.work_in, s.dissipated];
-                        let impulse = mass * (-(next[state::V] - y[state::V]) - base.integral(h));
-                        *y = next;
-                        return self.finish_step(
-                            zeta,
-                            tracker,
-                            impulse * inv_h,
-                            SolveStats {
-                                accepted: 1,
-                                ..SolveStats::default()
-                            },
-                        );
-                    }
+                // model = Auto: the exact linear solution while the hardening is below the
+                // threshold.
+                if let Some((threshold, mode)) = linear_below.as_mut()
+                    && let Some(next) = linear_step(model, *threshold, mode, zeta, y, h, &base)
+                {
+                    let impulse = mass * (-(next[state::V] - y[state::V]) - base.integral(h));
+                    *y = next;
+                    return self.finish_step(
+                        zeta,
+                        tracker,
+                        impulse * inv_h,
+                        SolveStats {
+                            accepted: 1,
+                            ..SolveStats::default()
+                        },
+                    );
                 }
                 // The integrators change nothing of themselves when they fail; a runaway found
                 // after a successful integration puts their carried step sizes back.
@@ -654,46 +725,25 @@ impl Simulation {
                 *y = next;
                 (stats, impulse)
             }
-            Dynamics::Linear { modes } => {
-                // Exact propagation cannot fail; only the fundamental mode can run away (the
-                // higher ones respond less), so it is checked before anything changes.
-                let (first, mut impulse) = advance_mode(&modes[0], zeta, h, &base);
-                check_runaway(first.2.x, limit)?;
-                modes[0] = first;
-                for mode in modes.iter_mut().skip(1) {
-                    let (next, i) = advance_mode(mode, zeta, h, &base);
-                    *mode = next;
-                    impulse += i;
-                }
-                (
-                    SolveStats {
-                        accepted: 1,
-                        ..SolveStats::default()
-                    },
-                    impulse,
-                )
-            }
+            Dynamics::Linear { modes } => step_linear(modes, zeta, h, &base, limit)?,
             Dynamics::Slamming { mode, impact } => {
-                let (sloshing, slosh_impulse) = advance_mode(mode, zeta, h, &base);
-                check_runaway(sloshing.2.x, limit)?;
-                let mut slam = impact.2;
-                let per_mass = impact
-                    .0
-                    .advance(&mut slam, h, &base)
-                    .map_err(StepError::Chattering)?;
-                let impulse = slosh_impulse + impact.1 * per_mass;
-                *mode = sloshing;
-                impact.2 = slam;
-                (
-                    SolveStats {
-                        accepted: 1,
-                        ..SolveStats::default()
-                    },
-                    impulse,
-                )
+                step_slamming(mode, impact, zeta, h, &base, limit)?
             }
         };
         self.finish_step(zeta, tracker, impulse * inv_h, stats)
+    }
+
+    /// The amplitude tracker after a step of `h` under `inputs`, and the damping it gives.
+    #[inline(never)]
+    fn track(
+        &self,
+        tracker: &AmplitudeTracker,
+        h: f64,
+        inputs: &Inputs,
+    ) -> (f64, Option<AmplitudeTracker>) {
+        let mut tr = tracker.clone();
+        tr.update(h, inputs.a, inputs.v);
+        (self.config.zeta(tr.estimate()), Some(tr))
     }
 
     /// Commit what a successful step changed besides the model's state.
@@ -855,14 +905,62 @@ impl Simulation {
         }
     }
 
-    /// The output `which` now.
+    /// The output `which` now. The three a master reads after every step are dispatched
+    /// first, by direct branches the caller can inline; the others by a table.
     #[inline]
     pub fn output(&self, which: Output, inputs: &Inputs) -> f64 {
-        let m = self.derived.mass_slosh;
-        let nonlinear = match &self.dynamics {
+        match which {
+            Output::X => self.x(),
+            Output::V => self.v(),
+            Output::Force => self.force(),
+            _ => self.other_output(which, inputs),
+        }
+    }
+
+    /// The nonlinear model and its state, if that is the model.
+    #[inline]
+    fn nonlinear(&self) -> Option<(&NonlinearTld, &[f64; state::DIM])> {
+        match &self.dynamics {
             Dynamics::Nonlinear { model, y, .. } => Some((model, y)),
             _ => None,
-        };
+        }
+    }
+
+    /// Relative displacement of the (fundamental) sloshing mass.
+    #[inline]
+    fn x(&self) -> f64 {
+        self.nonlinear()
+            .map_or_else(|| self.linear_modes()[0].2.x, |(_, y)| y[state::X])
+    }
+
+    /// Relative velocity of the (fundamental) sloshing mass.
+    #[inline]
+    fn v(&self) -> f64 {
+        self.nonlinear()
+            .map_or_else(|| self.linear_modes()[0].2.v, |(_, y)| y[state::V])
+    }
+
+    /// Force of the liquid on the tanks.
+    #[inline]
+    fn force(&self) -> f64 {
+        match self.nonlinear() {
+            Some((model, y)) => {
+                self.derived.mass_slosh * model.tank_force(y[state::X], y[state::V])
+            }
+            None => self
+                .linear_modes()
+                .iter()
+                .map(|(mode, m, s)| m * mode.tank_force(s))
+                .sum(),
+        }
+    }
+
+    /// Every output but the three of [`Simulation::output`]'s direct branches (which it also
+    /// answers).
+    #[inline(never)]
+    fn other_output(&self, which: Output, inputs: &Inputs) -> f64 {
+        let m = self.derived.mass_slosh;
+        let nonlinear = self.nonlinear();
         // Sums over the linear modes and the impact mass, formed only where an output needs them.
         let over_modes = |f: &dyn Fn(&Mode, &ModeState) -> f64| {
             self.linear_modes()
@@ -873,18 +971,13 @@ impl Simulation {
         let over_impact =
             |f: &dyn Fn(&SlamState) -> f64| self.impact().map_or(0.0, |(m, s)| m * f(s));
         match which {
-            Output::X => nonlinear.map_or_else(|| self.linear_modes()[0].2.x, |(_, y)| y[state::X]),
-            Output::V => nonlinear.map_or_else(|| self.linear_modes()[0].2.v, |(_, y)| y[state::V]),
-            Output::Force => match nonlinear {
-                Some((model, y)) => m * model.tank_force(y[state::X], y[state::V]),
-                None => over_modes(&|mode, s| mode.tank_force(s)),
-            },
-            Output::ForceMean => self
-                .last_mean_force
-                .unwrap_or_else(|| self.output(Output::Force, inputs)),
+            Output::X => self.x(),
+            Output::V => self.v(),
+            Output::Force => self.force(),
+            Output::ForceMean => self.last_mean_force.unwrap_or_else(|| self.force()),
             // The impact mass resting on a wall moves with the tank, like the inactive liquid.
             Output::BaseShear => {
-                self.output(Output::Force, inputs)
+                self.force()
                     - self.derived.mass_inactive * inputs.a
                     - over_impact(&|s| if s.contact != 0 { inputs.a } else { 0.0 })
             }
