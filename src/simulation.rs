@@ -367,7 +367,6 @@ fn linear_step(
 /// model = Linear: every mode advanced exactly; the statistics of the step and the impulse of
 /// the modes' forces on the tank. Exact propagation cannot fail; only the fundamental mode can
 /// run away (the higher ones respond less), so it is checked before anything changes.
-#[inline(never)]
 fn step_linear(
     modes: &mut [(Mode, f64, ModeState)],
     zeta: f64,
@@ -393,7 +392,6 @@ fn step_linear(
 }
 
 /// model = SloshingSlamming: the sloshing mode exactly, the impact mass event by event.
-#[inline(never)]
 fn step_slamming(
     mode: &mut (Mode, f64, ModeState),
     impact: &mut (Slamming, f64, SlamState),
