@@ -4,15 +4,14 @@
 
 use crate::solver::Rhs;
 
-/// |xi|^(2 eta - 2), specialised so integer exponents cost multiplications, not a powf. The
+/// |x|^(2 eta - 2), specialised so integer exponents cost multiplications, not a powf. The
 /// usual exponents (eta = 1.5, 2, 2.5, 3) have a variant each: one dispatch per evaluation, in
 /// the innermost loop of every integrator.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Power {
-    /// phi = 0: no hardening.
-    None,
-    /// eta = 1: |xi|^0 = 1, a constant extra stiffness phi.
-    Constant,
+    /// |x|^0 = 1: eta = 1 (a constant extra stiffness phi), or phi = 0 (no hardening at all,
+    /// whatever eta; then without a powf).
+    Zero,
     One,
     Two,
     Three,
@@ -42,9 +41,13 @@ fn int_pow(x: f64, mut n: u32) -> f64 {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PowerLaw {
     omega2: f64,
-    phi: f64,
     eta: f64,
-    inv_half_length: f64,
+    /// phi (2/a)^(2 eta - 2): the hardening is q |x|^(2 eta - 2), one multiplication and no
+    /// scaling of x on the path of every evaluation.
+    q: f64,
+    /// omega_f^2 q, so that Phi = omega_f^2 x + (omega_f^2 q x) |x|^(2 eta - 2): the power and
+    /// the scaled x are formed side by side, then one multiplication and one addition.
+    omega2_q: f64,
     power: Power,
 }
 
@@ -52,26 +55,26 @@ impl PowerLaw {
     /// `eta` >= 1 (real), `phi` >= 0, `length` = a.
     pub fn new(omega_f: f64, phi: f64, eta: f64, length: f64) -> Self {
         let p = 2.0 * eta - 2.0;
-        let power = if phi == 0.0 {
-            Power::None
-        } else if p == 0.0 {
-            Power::Constant
+        let (power, q) = if phi == 0.0 || p == 0.0 {
+            (Power::Zero, phi)
         } else if p.fract() == 0.0 && p <= 64.0 {
-            match p as u32 {
+            let power = match p as u32 {
                 1 => Power::One,
                 2 => Power::Two,
                 3 => Power::Three,
                 4 => Power::Four,
                 n => Power::Int(n),
-            }
+            };
+            (power, phi * (2.0 / length).powf(p))
         } else {
-            Power::Real(p)
+            (Power::Real(p), phi * (2.0 / length).powf(p))
         };
+        let omega2 = omega_f * omega_f;
         PowerLaw {
-            omega2: omega_f * omega_f,
-            phi,
+            omega2,
             eta,
-            inv_half_length: 2.0 / length,
+            q,
+            omega2_q: omega2 * q,
             power,
         }
     }
@@ -86,29 +89,34 @@ impl PowerLaw {
         self.eta
     }
 
+    /// |x|^(2 eta - 2).
+    #[inline]
+    fn abs_pow(&self, x: f64) -> f64 {
+        let ax = x.abs();
+        match self.power {
+            Power::Zero => 1.0,
+            Power::One => ax,
+            Power::Two => x * x,
+            Power::Three => ax * ax * ax,
+            Power::Four => {
+                let s = x * x;
+                s * s
+            }
+            Power::Int(n) => int_pow(ax, n),
+            Power::Real(p) => ax.powf(p),
+        }
+    }
+
     /// phi |xi|^(2 eta - 2): the hardening of the stiffness relative to the linear one.
     #[inline]
     pub fn hardening(&self, x: f64) -> f64 {
-        let xi = (x * self.inv_half_length).abs();
-        match self.power {
-            Power::None => 0.0,
-            Power::Constant => self.phi,
-            Power::One => self.phi * xi,
-            Power::Two => self.phi * (xi * xi),
-            Power::Three => self.phi * (xi * xi * xi),
-            Power::Four => {
-                let s = xi * xi;
-                self.phi * (s * s)
-            }
-            Power::Int(n) => self.phi * int_pow(xi, n),
-            Power::Real(p) => self.phi * xi.powf(p),
-        }
+        self.q * self.abs_pow(x)
     }
 
     /// Phi(x), odd in x.
     #[inline]
     pub fn force(&self, x: f64) -> f64 {
-        self.omega2 * x * (1.0 + self.hardening(x))
+        self.omega2 * x + (self.omega2_q * x) * self.abs_pow(x)
     }
 
     /// dPhi/dx = omega_f^2 [1 + (2 eta - 1) phi |xi|^(2eta-2)]: the local stiffness.
@@ -201,10 +209,11 @@ impl Rhs<{ state::DIM }> for NonlinearTld {
     #[inline]
     fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
         let (x, v) = (y[state::X], y[state::V]);
-        let f = self.tank_force(x, v);
         let a_b = self.base.at(t);
         dy[state::X] = v;
-        dy[state::V] = -a_b - f;
+        // The restoring force last: it ends the longest chain (x to Phi), so one subtraction
+        // follows it, not two.
+        dy[state::V] = (-a_b - self.c * v) - self.stiffness.force(x);
         dy[state::WORK_IN] = -a_b * v;
         dy[state::DISSIPATED] = self.c * v * v;
     }
