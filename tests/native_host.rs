@@ -974,3 +974,74 @@ fn slamming_state_round_trip() {
         b.lib.fmi2FreeFMUstate(b.c, &mut r);
     }
 }
+
+/// The per-step calls have fast paths; they must step aside when the host asks for every
+/// call to be logged, and refuse exactly as before.
+#[test]
+fn per_step_calls_are_logged_when_asked_and_refused_as_before() {
+    let mut inst = Instance::new("per-step-calls");
+    inst.initialise();
+    let lib = library();
+    let count =
+        |inst: &Instance, name: &str| inst.logs().iter().filter(|m| m.contains(name)).count();
+    assert_eq!(inst.set_real(vr::BASE_A, 0.5), OK);
+    assert_eq!(inst.get_real(vr::SLOSH_X).0, OK);
+    assert_eq!(inst.do_step(0.01), OK);
+    assert_eq!(
+        count(&inst, "fmi2SetReal") + count(&inst, "fmi2GetReal"),
+        0,
+        "not asked"
+    );
+
+    let name = CString::new("logCalls").unwrap();
+    let ptrs = [name.as_ptr()];
+    assert_eq!(
+        unsafe { lib.fmi2SetDebugLogging(inst.c, 1, 1, ptrs.as_ptr()) },
+        OK
+    );
+    assert_eq!(inst.set_real(vr::BASE_A, 0.25), OK);
+    let (s, x) = inst.get_real(vr::SLOSH_X);
+    assert_eq!(s, OK);
+    assert!(x.is_finite());
+    assert_eq!(inst.do_step(0.01), OK);
+    assert_eq!(count(&inst, "fmi2SetReal"), 1, "{:?}", inst.logs());
+    assert_eq!(count(&inst, "fmi2GetReal"), 1, "{:?}", inst.logs());
+    assert_eq!(count(&inst, "fmi2DoStep"), 1, "{:?}", inst.logs());
+
+    // Refusals while stepping, logging off again: the same statuses and reasons as ever.
+    assert_eq!(
+        unsafe { lib.fmi2SetDebugLogging(inst.c, 0, 0, std::ptr::null()) },
+        OK
+    );
+    let before = inst.logs().len();
+    assert_eq!(inst.set_real(vr::BASE_A, f64::NAN), ERROR);
+    assert_eq!(inst.set_real(vr::FORCE, 1.0), ERROR);
+    assert_eq!(inst.set_real(vr::ETA, 3.0), ERROR);
+    assert_eq!(inst.get_real(9999).0, ERROR);
+    let logs = inst.logs()[before..].to_vec();
+    assert_eq!(logs.len(), 4, "{logs:?}");
+    assert!(logs[0].contains("must be finite"), "{logs:?}");
+    assert!(logs[1].contains("cannot be set"), "{logs:?}");
+    assert!(logs[2].contains("fixed parameter"), "{logs:?}");
+    assert!(logs[3].contains("unknown value reference"), "{logs:?}");
+    // Two values at once, one of them an output: neither is applied, by the general path.
+    let vrs = [vr::BASE_A, vr::FORCE];
+    let before_a = inst.get_real(vr::BASE_A).1;
+    assert_eq!(
+        unsafe { lib.fmi2SetReal(inst.c, vrs.as_ptr(), 2, [9.0, 1.0].as_ptr()) },
+        ERROR
+    );
+    assert_eq!(inst.get_real(vr::BASE_A).1, before_a);
+    // Reads of several kinds in one call: outputs, an input, a parameter, a calculated one.
+    let vrs = [vr::SLOSH_X, vr::BASE_A, vr::ETA, vr::OMEGA_F, vr::FORCE];
+    let mut out = [f64::NAN; 5];
+    assert_eq!(
+        unsafe { lib.fmi2GetReal(inst.c, vrs.as_ptr(), 5, out.as_mut_ptr()) },
+        OK
+    );
+    assert_eq!(out[0], inst.get_real(vr::SLOSH_X).1);
+    assert_eq!(out[1], 0.25);
+    assert_eq!(out[2], inst.get_real(vr::ETA).1);
+    assert!((out[3] - 5.6389).abs() < 5e-5, "{out:?}");
+    assert_eq!(out[4], inst.get_real(vr::FORCE).1);
+}

@@ -50,6 +50,22 @@ fn guard(
     }
 }
 
+/// A per-step call's fast path on the instance behind `c` (see `Instance::fast_get_real`):
+/// its status if it took the call, None to send the call down the general path, which checks
+/// in full, logs, and turns panics into errors (a panic here only sends the call there).
+#[inline(always)]
+fn fast(
+    c: fmi2Component,
+    body: impl FnOnce(&mut Instance) -> Option<Status>,
+) -> Option<fmi2Status> {
+    // SAFETY: as in `guard`.
+    let inst = unsafe { Instance::from_ptr(c) }?;
+    match catch_unwind(AssertUnwindSafe(|| body(inst))) {
+        Ok(Some(status)) => Some(status as fmi2Status),
+        _ => None,
+    }
+}
+
 /// A host array of `n` elements; `n` = 0 accepts a null pointer.
 #[inline(always)]
 unsafe fn host_slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Result<&'a [T], Refusal> {
@@ -242,6 +258,10 @@ pub unsafe extern "C" fn fmi2GetReal(
     nvr: usize,
     value: *mut fmi2Real,
 ) -> fmi2Status {
+    // SAFETY: the host's arrays of nvr elements, checked by the fast path before use.
+    if let Some(status) = fast(c, |inst| unsafe { inst.fast_get_real(vr, nvr, value) }) {
+        return status;
+    }
     guard(c, "fmi2GetReal", |inst| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, out) = unsafe {
@@ -331,6 +351,10 @@ pub unsafe extern "C" fn fmi2SetReal(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
+    // SAFETY: the host's arrays of nvr elements, checked by the fast path before use.
+    if let Some(status) = fast(c, |inst| unsafe { inst.fast_set_real(vr, nvr, value) }) {
+        return status;
+    }
     guard(c, "fmi2SetReal", |inst| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, vals) = unsafe {

@@ -199,7 +199,7 @@ impl Instance {
 
     /// Log a call when the host asked for logCalls.
     pub fn trace(&self, describe: impl FnOnce() -> String) {
-        if self.logging_on && self.log_calls {
+        if self.logs_calls() {
             self.logger
                 .log(&self.name, Status::Ok, "logCalls", &describe());
         }
@@ -435,6 +435,75 @@ impl Instance {
             put(k, value);
         }
         Ok(Status::Ok)
+    }
+
+    /// Whether the host asked for every call to be logged.
+    #[inline]
+    fn logs_calls(&self) -> bool {
+        self.logging_on && self.log_calls
+    }
+
+    /// fmi2GetReal's fast path, for the per-step reads of a running simulation: what `get`
+    /// answers when it succeeds, without building argument slices or refusals. None (nothing
+    /// written that matters: the general path then writes every value or refuses) when a
+    /// pointer is null or misaligned, calls are logged, the state does not allow gets, there is
+    /// no simulation yet, or a variable is anything but a Real output or stored Real.
+    ///
+    /// # Safety
+    /// `vr` and `value`, when not null, must point to `nvr` elements each.
+    #[inline(always)]
+    pub unsafe fn fast_get_real(
+        &self,
+        vr: *const u32,
+        nvr: usize,
+        value: *mut f64,
+    ) -> Option<Status> {
+        if vr.is_null() || value.is_null() || !vr.is_aligned() || !value.is_aligned() {
+            return None;
+        }
+        if self.phase.bit() & allow::GET == 0 || self.logs_calls() {
+            return None;
+        }
+        let sim = self.sim.as_ref()?;
+        let inputs = self.values.inputs(self.a_derivatives);
+        for k in 0..nvr {
+            // SAFETY: k < nvr, per the contract.
+            let r = unsafe { *vr.add(k) };
+            let v = match source_of(r, VarType::Real) {
+                Source::Output(which) => sim.output(which, &inputs),
+                Source::Stored(index) => self.values.at(index),
+                _ => return None,
+            };
+            // SAFETY: k < nvr, per the contract.
+            unsafe { *value.add(k) = v };
+        }
+        Some(Status::Ok)
+    }
+
+    /// fmi2SetReal's fast path, for the per-step input: one variable that `set` would accept,
+    /// set the same way. None (nothing changed) for anything else, and whenever calls are
+    /// logged; the general path then takes the call.
+    ///
+    /// # Safety
+    /// `vr` and `value`, when not null, must point to `nvr` elements each.
+    #[inline(always)]
+    pub unsafe fn fast_set_real(
+        &mut self,
+        vr: *const u32,
+        nvr: usize,
+        value: *const f64,
+    ) -> Option<Status> {
+        if nvr != 1 || vr.is_null() || value.is_null() || !vr.is_aligned() || !value.is_aligned() {
+            return None;
+        }
+        if self.phase.bit() & allow::SET == 0 || self.logs_calls() {
+            return None;
+        }
+        // SAFETY: one element each, per the contract.
+        let (r, v) = unsafe { (*vr, *value) };
+        let index = self.check_set(r, v, VarType::Real, "fmi2SetReal").ok()?;
+        self.put(r, index, v);
+        Some(Status::Ok)
     }
 
     /// An output before the simulation exists: from the simulation the values would start.
