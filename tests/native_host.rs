@@ -1044,4 +1044,13 @@ fn per_step_calls_are_logged_when_asked_and_refused_as_before() {
     assert_eq!(out[2], inst.get_real(vr::ETA).1);
     assert!((out[3] - 5.6389).abs() < 5e-5, "{out:?}");
     assert_eq!(out[4], inst.get_real(vr::FORCE).1);
+    // A count no array can hold (a host's -1 as size_t) is refused before anything is
+    // written, even where the first entries would be readable.
+    let vrs = [vr::SLOSH_X, vr::SLOSH_X, vr::SLOSH_X, 9999];
+    let mut out = [f64::NAN; 3];
+    assert_eq!(
+        unsafe { lib.fmi2GetReal(inst.c, vrs.as_ptr(), usize::MAX, out.as_mut_ptr()) },
+        ERROR
+    );
+    assert!(out.iter().all(|v| v.is_nan()), "{out:?}");
 }

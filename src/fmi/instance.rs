@@ -458,7 +458,14 @@ impl Instance {
         nvr: usize,
         value: *mut f64,
     ) -> Option<Status> {
-        if vr.is_null() || value.is_null() || !vr.is_aligned() || !value.is_aligned() {
+        // The general path refuses counts no array can hold before touching anything; so
+        // must this one (a host's -1 as size_t would otherwise be written through).
+        if vr.is_null()
+            || value.is_null()
+            || !vr.is_aligned()
+            || !value.is_aligned()
+            || nvr > isize::MAX as usize / size_of::<f64>()
+        {
             return None;
         }
         if self.phase.bit() & allow::GET == 0 || self.logs_calls() {

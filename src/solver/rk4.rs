@@ -23,7 +23,7 @@ impl Rk4 {
         // One step when the interval fits: the common case, kept free of the step count's
         // integer-float conversions (u64 to f64 takes several instructions on x86-64) and of
         // ceil (a libm call on baseline x86-64).
-        if span <= self.max_step {
+        if span <= self.max_step && self.max_steps >= 1 {
             let z = step(f, t0, span, y);
             if !all_finite(&z) {
                 return Err(SolveError::NonFinite { t: t0 });
