@@ -35,14 +35,18 @@ impl Rk4 {
                 evaluations: 4,
             });
         }
-        let n = (span / self.max_step * (1.0 - 1e-12)).ceil().max(1.0);
-        if n > self.max_steps as f64 {
+        // n = ceil(q) steps, and ceil(q) <= max_steps exactly when q <= max_steps; formed
+        // without libm's ceil (a call on baseline x86-64), counted in i64 (one instruction
+        // to f64, where u64 takes several).
+        let q = span / self.max_step * (1.0 - 1e-12);
+        if q.is_nan() || q > self.max_steps as f64 {
             return Err(SolveError::TooManySteps {
                 limit: self.max_steps,
                 t: t0,
             });
         }
-        let n = n as u64;
+        let whole = q as i64;
+        let n = if (whole as f64) < q { whole + 1 } else { whole }.max(1);
         let h = span / n as f64;
         let mut z = *y;
         for i in 0..n {
@@ -52,6 +56,7 @@ impl Rk4 {
                 return Err(SolveError::NonFinite { t });
             }
         }
+        let n = n as u64;
         *y = z;
         Ok(SolveStats {
             accepted: n,
