@@ -394,7 +394,7 @@ impl Instance {
         function: &str,
     ) -> Result<(usize, &'static Variable), Refusal> {
         let (index, var) = Self::variable(vr, function)?;
-        if var.ty == ty || (ty == VarType::Integer && var.ty == VarType::Enumeration) {
+        if var.accessed_as(ty) {
             Ok((index, var))
         } else {
             Err(Self::wrong_type(vr, var, function))

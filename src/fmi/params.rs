@@ -208,9 +208,7 @@ pub const fn source(vr: u32, ty: VarType) -> Source {
         None => return Source::Unknown,
     };
     let var = &VARIABLES[index];
-    let same = var.ty as u8 == ty as u8
-        || (matches!(ty, VarType::Integer) && matches!(var.ty, VarType::Enumeration));
-    if !same {
+    if !var.accessed_as(ty) {
         return Source::WrongType(index);
     }
     match var.causality {

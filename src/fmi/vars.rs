@@ -55,6 +55,13 @@ pub const fn index_of(vr: u32) -> Option<usize> {
 }
 
 impl Variable {
+    /// Whether the getters and setters of type `ty` address this variable: its own type, and
+    /// the Integer ones Enumerations too (FMI 2.0 has no Enumeration getter).
+    pub const fn accessed_as(&self, ty: VarType) -> bool {
+        self.ty as u8 == ty as u8
+            || (matches!(ty, VarType::Integer) && matches!(self.ty, VarType::Enumeration))
+    }
+
     /// Why `value` is not acceptable for this variable, if it is not.
     #[inline]
     pub fn reject(&self, value: f64) -> Option<String> {
