@@ -35,31 +35,9 @@ from libcosimpy.CosimSlave import CosimLocalSlave
 from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 
 from conftest import MODELS_APART
+from host_scene import DT, N, OUTPUTS, RTOL, T_END, base_acceleration, compare, rel_diff, run_fmpy
 
 log_output_level(CosimLogLevel.WARNING)   # libcosim traces every FMI call otherwise
-
-DT = 0.01
-T_END = 20.0
-N = int(round(T_END / DT))
-W = 5.6389          # rad/s
-A = 0.005           # m
-OUTPUTS = ["slosh.x", "force"]
-RTOL = 1e-9
-
-
-def base_acceleration(scale=1.0, shift=0):
-    """base.a = -w^2 A sin(w t), sampled at the communication points t_k = k dt (the value held
-    during step k); shift moves the samples by whole steps (for the can-fail checks)."""
-    t = (np.arange(N) + shift) * DT
-    return -W * W * A * scale * np.sin(W * t)
-
-
-def run_fmpy(slave_factory, a, reals=None, ints=None):
-    s = slave_factory(quiet=True)
-    s.initialize({**(reals or {}), **(ints or {})})
-    res = s.run(DT, {"base.a": a}, OUTPUTS)
-    # res[name][0] is the value before the first step; libcosim's observer starts after it
-    return {k: v[1:] for k, v in res.items()}
 
 
 def run_libcosim(fmu_path, variables, a, reals=None, ints=None):
@@ -87,14 +65,6 @@ def run_libcosim(fmu_path, variables, a, reals=None, ints=None):
     assert abs(status.current_time * 1e-9 - T_END) < 1e-9, status
     del ex   # frees the instance (fmi2FreeInstance) before the slave objects go
     return {n: res[:, j] for j, n in enumerate(OUTPUTS)}
-
-
-def rel_diff(x, y):
-    return float(np.max(np.abs(x - y)) / np.max(np.abs(y)))
-
-
-def compare(lc, fm):
-    return {n: rel_diff(lc[n], fm[n]) for n in OUTPUTS}
 
 
 # the brief's scene: damping = Constant (integer 1) cannot be set through libcosimpy (see the

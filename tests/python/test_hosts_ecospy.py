@@ -66,6 +66,9 @@ import numpy as np
 import pytest
 
 from conftest import MODELS_APART
+from host_scene import (
+    DT, N, OUTPUTS, RTOL, T_END, base_acceleration, bitwise, compare, rel_diff, run_fmpy,
+)
 
 
 def _load_tbb():
@@ -84,13 +87,6 @@ from ecospy import EcosLib, EcosSimulation, EcosSimulationStructure, SimulationL
 
 EcosLib.set_log_level("warn")   # proxyfmu logs every boot at "info"
 
-DT = 0.01
-T_END = 20.0
-N = int(round(T_END / DT))
-W = 5.6389          # rad/s
-A = 0.005           # m
-OUTPUTS = ["slosh.x", "force"]
-RTOL = 1e-9
 INSTANCE = "tld"
 
 _UNZIP_STANDIN = '''#!{python}
@@ -123,33 +119,6 @@ def ecos_unzip(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("PATH", f"{d}{os.pathsep}{os.environ.get('PATH', '')}")
         yield "stand-in"
-
-
-def base_acceleration(scale=1.0, shift=0):
-    """base.a at the communication points t_k = k dt (held during step k); `shift` moves the
-    samples by whole steps (for the can-fail checks)."""
-    t = (np.arange(N) + shift) * DT
-    return -W * W * A * scale * np.sin(W * t)
-
-
-def rel_diff(x, y):
-    return float(np.max(np.abs(np.asarray(x) - np.asarray(y))) / np.max(np.abs(y)))
-
-
-def compare(ec, fm):
-    return {n: rel_diff(ec[n], fm[n]) for n in OUTPUTS}
-
-
-def bitwise(ec, fm):
-    return all(np.array_equal(ec[n], fm[n]) for n in OUTPUTS)
-
-
-def run_fmpy(slave_factory, a, params=None):
-    s = slave_factory(quiet=True)
-    s.initialize(dict(params or {}))
-    res = s.run(DT, {"base.a": a}, OUTPUTS)
-    # res[name][0] is the value before the first step; the Ecos runs below record after each step
-    return {k: v[1:] for k, v in res.items()}
 
 
 class _Feeder(SimulationListener):
