@@ -6,9 +6,9 @@ use crate::physics::geometry::Tank;
 use crate::physics::laws::nsd_kappa;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::physics::linear::{Mode, ModeState};
-use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, state};
+use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, RhsJob, state};
 use crate::physics::slamming::{SlamState, Slamming};
-use crate::solver::{Auto, Dop853, Dopri5, Rk4, Sdirk4, SolveError, SolveStats};
+use crate::solver::{Auto, Dop853, Dopri5, Rhs, Rk4, Sdirk4, SolveError, SolveStats};
 
 /// Where the excitation amplitude of the amplitude laws comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -276,9 +276,9 @@ enum Integrator {
 }
 
 impl Integrator {
-    fn integrate(
+    fn integrate<F: Rhs<{ state::DIM }>>(
         &mut self,
-        model: &NonlinearTld,
+        model: &F,
         t0: f64,
         t1: f64,
         y: &mut [f64; state::DIM],
@@ -311,6 +311,20 @@ impl Integrator {
             Integrator::Auto(m) => m.set_memory(h),
             Integrator::Rk4(_) => {}
         }
+    }
+}
+
+/// One interval of the nonlinear model, 0 to h, handed the model compiled for its exponent.
+struct Interval<'a> {
+    integrator: &'a mut Integrator,
+    h: f64,
+    y: &'a mut [f64; state::DIM],
+}
+
+impl RhsJob for Interval<'_> {
+    type Output = Result<SolveStats, SolveError>;
+    fn run<F: Rhs<{ state::DIM }>>(self, f: &F) -> Self::Output {
+        self.integrator.integrate(f, 0.0, self.h, self.y)
     }
 }
 
@@ -707,8 +721,12 @@ impl Simulation {
                 // The integrators change nothing of themselves when they fail; a runaway found
                 // after a successful integration puts their carried step sizes back.
                 let carried = integrator.memory();
-                let outcome = integrator
-                    .integrate(model, 0.0, h, &mut next)
+                let outcome = model
+                    .with_exponent(Interval {
+                        integrator,
+                        h,
+                        y: &mut next,
+                    })
                     .map_err(|e| StepError::Solver(e.shifted(t)))
                     .and_then(|stats| check_runaway(next[state::X], limit).map(|()| stats));
                 let stats = match outcome {

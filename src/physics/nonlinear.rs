@@ -4,36 +4,119 @@
 
 use crate::solver::Rhs;
 
-/// |x|^(2 eta - 2), specialised so integer exponents cost multiplications, not a powf. The
-/// usual exponents (eta = 1.5, 2, 2.5, 3) have a variant each: one dispatch per evaluation, in
-/// the innermost loop of every integrator.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Power {
+/// |x|^(2 eta - 2) for one kind of exponent, integer exponents by multiplications rather than
+/// a powf. [`Power`] holds any kind and dispatches at run time; the fixed kinds of [`exponent`]
+/// let an integrator be compiled for one exponent ([`NonlinearTld::with_exponent`]), so that no
+/// dispatch sits in its stages: one there costs its jump and, worse, spills the stage values
+/// around it onto the stack, on the path from x to x''.
+pub trait Exponent: Copy {
+    fn abs_pow(self, x: f64) -> f64;
+}
+
+/// The kinds of exponent 2 eta - 2, each with its own evaluation.
+pub mod exponent {
+    use super::Exponent;
+
     /// |x|^0 = 1: eta = 1 (a constant extra stiffness phi), or phi = 0 (no hardening at all,
     /// whatever eta; then without a powf).
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Zero;
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct One;
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Two;
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Three;
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Four;
+    /// Any other integer exponent, by squaring.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Int(pub u32);
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Real(pub f64);
+
+    impl Exponent for Zero {
+        #[inline(always)]
+        fn abs_pow(self, _x: f64) -> f64 {
+            1.0
+        }
+    }
+    impl Exponent for One {
+        #[inline(always)]
+        fn abs_pow(self, x: f64) -> f64 {
+            x.abs()
+        }
+    }
+    impl Exponent for Two {
+        #[inline(always)]
+        fn abs_pow(self, x: f64) -> f64 {
+            x * x
+        }
+    }
+    impl Exponent for Three {
+        #[inline(always)]
+        fn abs_pow(self, x: f64) -> f64 {
+            let ax = x.abs();
+            ax * ax * ax
+        }
+    }
+    impl Exponent for Four {
+        #[inline(always)]
+        fn abs_pow(self, x: f64) -> f64 {
+            let s = x * x;
+            s * s
+        }
+    }
+    impl Exponent for Int {
+        /// By squaring: `powi` with an exponent known only at run time becomes a call to a
+        /// generic routine several times slower.
+        #[inline(always)]
+        fn abs_pow(self, x: f64) -> f64 {
+            let (mut base, mut out, mut n) = (x.abs(), 1.0, self.0);
+            while n > 0 {
+                if n & 1 == 1 {
+                    out *= base;
+                }
+                base *= base;
+                n >>= 1;
+            }
+            out
+        }
+    }
+    impl Exponent for Real {
+        #[inline(always)]
+        fn abs_pow(self, x: f64) -> f64 {
+            x.abs().powf(self.0)
+        }
+    }
+}
+
+/// The exponent of a power law, of whichever kind (the usual eta = 1.5, 2, 2.5, 3 have a kind
+/// each).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Power {
     Zero,
     One,
     Two,
     Three,
     Four,
-    /// Any other integer exponent, by squaring.
     Int(u32),
     Real(f64),
 }
 
-/// x^n by squaring: `powi` with an exponent known only at run time becomes a call to a generic
-/// routine several times slower.
-#[inline(always)]
-fn int_pow(x: f64, mut n: u32) -> f64 {
-    let (mut base, mut out) = (x, 1.0);
-    while n > 0 {
-        if n & 1 == 1 {
-            out *= base;
+impl Exponent for Power {
+    #[inline]
+    fn abs_pow(self, x: f64) -> f64 {
+        match self {
+            Power::Zero => exponent::Zero.abs_pow(x),
+            Power::One => exponent::One.abs_pow(x),
+            Power::Two => exponent::Two.abs_pow(x),
+            Power::Three => exponent::Three.abs_pow(x),
+            Power::Four => exponent::Four.abs_pow(x),
+            Power::Int(n) => exponent::Int(n).abs_pow(x),
+            Power::Real(p) => exponent::Real(p).abs_pow(x),
         }
-        base *= base;
-        n >>= 1;
     }
-    out
 }
 
 /// The restoring characteristic Phi of Eq 2.13 (per unit sloshing mass), xi = 2x/a so that
@@ -89,34 +172,22 @@ impl PowerLaw {
         self.eta
     }
 
-    /// |x|^(2 eta - 2).
-    #[inline]
-    fn abs_pow(&self, x: f64) -> f64 {
-        let ax = x.abs();
-        match self.power {
-            Power::Zero => 1.0,
-            Power::One => ax,
-            Power::Two => x * x,
-            Power::Three => ax * ax * ax,
-            Power::Four => {
-                let s = x * x;
-                s * s
-            }
-            Power::Int(n) => int_pow(ax, n),
-            Power::Real(p) => ax.powf(p),
-        }
-    }
-
     /// phi |xi|^(2 eta - 2): the hardening of the stiffness relative to the linear one.
     #[inline]
     pub fn hardening(&self, x: f64) -> f64 {
-        self.q * self.abs_pow(x)
+        self.q * self.power.abs_pow(x)
     }
 
     /// Phi(x), odd in x.
     #[inline]
     pub fn force(&self, x: f64) -> f64 {
-        self.omega2 * x + (self.omega2_q * x) * self.abs_pow(x)
+        self.force_with(self.power, x)
+    }
+
+    /// Phi(x) with the exponent `e`, which must be of this law's kind.
+    #[inline(always)]
+    fn force_with<E: Exponent>(&self, e: E, x: f64) -> f64 {
+        self.omega2 * x + (self.omega2_q * x) * e.abs_pow(x)
     }
 
     /// dPhi/dx = omega_f^2 [1 + (2 eta - 1) phi |xi|^(2eta-2)]: the local stiffness.
@@ -205,17 +276,77 @@ impl NonlinearTld {
     }
 }
 
-impl Rhs<{ state::DIM }> for NonlinearTld {
-    #[inline]
-    fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
+impl NonlinearTld {
+    /// The right-hand side with the exponent `e`, which must be of the law's kind.
+    #[inline(always)]
+    fn eval_with<E: Exponent>(
+        &self,
+        e: E,
+        t: f64,
+        y: &[f64; state::DIM],
+        dy: &mut [f64; state::DIM],
+    ) {
         let (x, v) = (y[state::X], y[state::V]);
         let a_b = self.base.at(t);
         dy[state::X] = v;
         // The restoring force last: it ends the longest chain (x to Phi), so one subtraction
         // follows it, not two.
-        dy[state::V] = (-a_b - self.c * v) - self.stiffness.force(x);
+        dy[state::V] = (-a_b - self.c * v) - self.stiffness.force_with(e, x);
         dy[state::WORK_IN] = -a_b * v;
         dy[state::DISSIPATED] = self.c * v * v;
+    }
+
+    /// Run `job` on this model as a right-hand side compiled for its kind of exponent: the
+    /// same values as the model itself, without a dispatch per evaluation. Inlined into the
+    /// caller: behind a call, the integrator's state would pass through memory both ways.
+    #[inline(always)]
+    pub fn with_exponent<J: RhsJob>(&self, job: J) -> J::Output {
+        fn fixed<E: Exponent, J: RhsJob>(model: &NonlinearTld, exponent: E, job: J) -> J::Output {
+            job.run(&Fixed { model, exponent })
+        }
+        match self.stiffness.power {
+            Power::Zero => fixed(self, exponent::Zero, job),
+            Power::One => fixed(self, exponent::One, job),
+            Power::Two => fixed(self, exponent::Two, job),
+            Power::Three => fixed(self, exponent::Three, job),
+            Power::Four => fixed(self, exponent::Four, job),
+            Power::Int(n) => fixed(self, exponent::Int(n), job),
+            Power::Real(p) => fixed(self, exponent::Real(p), job),
+        }
+    }
+}
+
+/// Work on a right-hand side whose type is chosen at run time ([`NonlinearTld::with_exponent`]).
+pub trait RhsJob {
+    type Output;
+    fn run<F: Rhs<{ state::DIM }>>(self, f: &F) -> Self::Output;
+}
+
+/// The model with its kind of exponent fixed at compile time.
+struct Fixed<'a, E> {
+    model: &'a NonlinearTld,
+    exponent: E,
+}
+
+impl<E: Exponent> Rhs<{ state::DIM }> for Fixed<'_, E> {
+    #[inline]
+    fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
+        self.model.eval_with(self.exponent, t, y, dy);
+    }
+
+    fn jacobian(&self, t: f64, y: &[f64; state::DIM], jac: &mut [[f64; state::DIM]; state::DIM]) {
+        self.model.jacobian(t, y, jac);
+    }
+
+    fn stiffness(&self, t: f64, y: &[f64; state::DIM]) -> f64 {
+        Rhs::stiffness(self.model, t, y)
+    }
+}
+
+impl Rhs<{ state::DIM }> for NonlinearTld {
+    #[inline]
+    fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
+        self.eval_with(self.stiffness.power, t, y, dy);
     }
 
     fn jacobian(&self, t: f64, y: &[f64; state::DIM], jac: &mut [[f64; state::DIM]; state::DIM]) {
@@ -333,6 +464,53 @@ mod tests {
         }
         // The local frequency at rest is omega_f.
         assert!((Rhs::stiffness(&m, 0.0, &[0.0; state::DIM]) - 5.6).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_compiled_exponent_gives_the_models_values() {
+        use crate::solver::Rhs;
+        struct Evaluate(Vec<[f64; state::DIM]>);
+        impl RhsJob for Evaluate {
+            type Output = Vec<[f64; state::DIM]>;
+            fn run<F: Rhs<{ state::DIM }>>(self, f: &F) -> Self::Output {
+                let mut jac = [[0.0; state::DIM]; state::DIM];
+                let y = [0.03, 0.2, 0.0, 0.0];
+                f.jacobian(0.1, &y, &mut jac);
+                let mut out: Vec<_> = self
+                    .0
+                    .iter()
+                    .map(|y| {
+                        let mut dy = [0.0; state::DIM];
+                        f.eval(0.1, y, &mut dy);
+                        dy
+                    })
+                    .collect();
+                out.extend(jac);
+                out.push([f.stiffness(0.1, &y), 0.0, 0.0, 0.0]);
+                out
+            }
+        }
+        // One eta per kind of exponent (2 eta - 2 = 0, 1, 2, 3, 4, 8, 3.4), and phi = 0.
+        for (eta, phi) in [(1.0, 1.0), (1.5, 1.0), (2.0, 1.0), (2.5, 0.7), (3.0, 1.0)]
+            .into_iter()
+            .chain([(5.0, 1.0), (2.7, 1.0), (3.0, 0.0)])
+        {
+            let m = NonlinearTld {
+                stiffness: PowerLaw::new(5.6, phi, eta, 0.25),
+                c: 0.3,
+                base: BaseAcceleration {
+                    t0: 0.0,
+                    a: [0.4, 1.0, -2.0],
+                },
+            };
+            let states: Vec<[f64; state::DIM]> = [-0.3, -0.11, -1e-3, 0.0, 2e-4, 0.07, 0.124, 0.4]
+                .iter()
+                .map(|&x| [x, 0.5 - x, 0.1, 0.2])
+                .collect();
+            let compiled = m.with_exponent(Evaluate(states.clone()));
+            let direct = Evaluate(states).run(&m);
+            assert_eq!(compiled, direct, "eta {eta} phi {phi}");
+        }
     }
 
     #[test]
