@@ -1024,6 +1024,20 @@ fn per_step_calls_are_logged_when_asked_and_refused_as_before() {
     assert!(logs[1].contains("cannot be set"), "{logs:?}");
     assert!(logs[2].contains("fixed parameter"), "{logs:?}");
     assert!(logs[3].contains("unknown value reference"), "{logs:?}");
+    // Every input: any finite value is taken as given, an infinite one refused and the
+    // value kept.
+    for r in [vr::BASE_A, vr::BASE_V, vr::BASE_X] {
+        for v in [f64::MAX, -f64::MAX, 0.0, -0.0, 5e-324] {
+            assert_eq!(inst.set_real(r, v), OK, "vr {r} = {v}");
+            assert_eq!(inst.get_real(r).1.to_bits(), v.to_bits(), "vr {r} = {v}");
+        }
+        for v in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            assert_eq!(inst.set_real(r, v), ERROR, "vr {r} = {v}");
+            assert_eq!(inst.get_real(r).1, 5e-324, "vr {r} after {v}");
+        }
+        assert_eq!(inst.set_real(r, 0.0), OK);
+    }
+    assert_eq!(inst.set_real(vr::BASE_A, 0.25), OK);
     // Two values at once, one of them an output: neither is applied, by the general path.
     let vrs = [vr::BASE_A, vr::FORCE];
     let before_a = inst.get_real(vr::BASE_A).1;

@@ -262,6 +262,19 @@ pub unsafe extern "C" fn fmi2GetReal(
     if let Some(status) = fast(c, |inst| unsafe { inst.fast_get_real(vr, nvr, value) }) {
         return status;
     }
+    // SAFETY: the host's arguments, passed on as they came.
+    unsafe { general_get_real(c, vr, nvr, value) }
+}
+
+/// fmi2GetReal's general path, out of line: the fast path then needs no stack frame
+/// of its size.
+#[inline(never)]
+unsafe fn general_get_real(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Real,
+) -> fmi2Status {
     guard(c, "fmi2GetReal", |inst| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, out) = unsafe {
@@ -355,6 +368,19 @@ pub unsafe extern "C" fn fmi2SetReal(
     if let Some(status) = fast(c, |inst| unsafe { inst.fast_set_real(vr, nvr, value) }) {
         return status;
     }
+    // SAFETY: the host's arguments, passed on as they came.
+    unsafe { general_set_real(c, vr, nvr, value) }
+}
+
+/// fmi2SetReal's general path, out of line: the fast path then needs no stack frame
+/// of its size.
+#[inline(never)]
+unsafe fn general_set_real(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2Real,
+) -> fmi2Status {
     guard(c, "fmi2SetReal", |inst| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, vals) = unsafe {

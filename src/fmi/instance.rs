@@ -4,9 +4,9 @@
 use std::ffi::CString;
 
 use super::logger::Logger;
-use super::params::{Source, Values, derived_value, output_of, source_of};
+use super::params::{Source, Values, derived_value, free_real_input, output_of, source_of};
 use super::snapshot::Saved;
-use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, index_of, vr};
+use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, finite, index_of, vr};
 use crate::simulation::{Inputs, Output, Simulation, StepError};
 use crate::solver::SolveError;
 
@@ -508,7 +508,11 @@ impl Instance {
         }
         // SAFETY: one element each, per the contract.
         let (r, v) = unsafe { (*vr, *value) };
-        let index = self.check_set(r, v, VarType::Real, "fmi2SetReal").ok()?;
+        // The per-step input by a table lookup; any other variable by the full check.
+        let index = match free_real_input(r) {
+            Some(index) if finite(v) => index,
+            _ => self.check_set(r, v, VarType::Real, "fmi2SetReal").ok()?,
+        };
         self.put(r, index, v);
         Some(Status::Ok)
     }
@@ -650,12 +654,12 @@ impl Instance {
     #[inline]
     pub fn do_step(&mut self, t: f64, h: f64) -> Reply {
         self.require(allow::STEP_COMPLETE, "fmi2DoStep")?;
-        if !(h.is_finite() && h > 0.0) {
+        if !(finite(h) && h > 0.0) {
             return Err(refuse(format!(
                 "fmi2DoStep: communicationStepSize {h} must be positive and finite"
             )));
         }
-        if !t.is_finite() {
+        if !finite(t) {
             return Err(refuse(format!(
                 "fmi2DoStep: currentCommunicationPoint {t} is not finite"
             )));

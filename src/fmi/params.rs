@@ -244,6 +244,40 @@ pub fn source_of(vr: u32, ty: VarType) -> Source {
     }
 }
 
+/// Where fmi2SetReal stores `vr` with no check but that the value is finite: a Real input
+/// without bounds (what `Instance::check_set` then checks, in every phase that allows sets).
+/// None for any other variable, which goes through the full check. A table the compiler
+/// builds, read on every step.
+const FREE_REAL_INPUTS: [Option<u8>; VR_INDEX.len()] = {
+    let mut table = [None; VR_INDEX.len()];
+    let mut vr = 0;
+    while vr < table.len() {
+        if let Some(index) = index_of(vr as u32) {
+            let var = &VARIABLES[index];
+            if matches!(var.causality, Causality::Input)
+                && matches!(var.ty, VarType::Real)
+                && var.min.is_none()
+                && var.max.is_none()
+                && index <= u8::MAX as usize
+            {
+                table[vr] = Some(index as u8);
+            }
+        }
+        vr += 1;
+    }
+    table
+};
+
+/// [`FREE_REAL_INPUTS`] of `vr`.
+#[inline(always)]
+pub fn free_real_input(vr: u32) -> Option<usize> {
+    FREE_REAL_INPUTS
+        .get(vr as usize)
+        .copied()
+        .flatten()
+        .map(usize::from)
+}
+
 /// The simulation output an output variable shows, by value reference.
 pub const fn output_of(vr: u32) -> Option<Output> {
     Some(match vr {
