@@ -29,9 +29,24 @@ pub mod exponent {
     pub struct Three;
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Four;
-    /// Any other integer exponent, by squaring.
+    /// Any other integer exponent n = odd 2^squarings (odd odd): the squarings first, one
+    /// multiplication each, then the odd power.
     #[derive(Clone, Copy, Debug, PartialEq)]
-    pub struct Int(pub u32);
+    pub struct Int {
+        squarings: u32,
+        odd: u32,
+    }
+
+    impl Int {
+        /// |x|^n, n > 0.
+        pub fn new(n: u32) -> Self {
+            let squarings = n.trailing_zeros().min(31);
+            Int {
+                squarings,
+                odd: n >> squarings,
+            }
+        }
+    }
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Real(pub f64);
 
@@ -68,19 +83,30 @@ pub mod exponent {
         }
     }
     impl Exponent for Int {
-        /// By squaring: `powi` with an exponent known only at run time becomes a call to a
-        /// generic routine several times slower.
+        /// `powi` with an exponent known only at run time would become a call to a generic
+        /// routine several times slower.
         #[inline(always)]
         fn abs_pow(self, x: f64) -> f64 {
-            let (mut base, mut out, mut n) = (x.abs(), 1.0, self.0);
-            while n > 0 {
-                if n & 1 == 1 {
-                    out *= base;
-                }
+            let mut base = x.abs();
+            for _ in 0..self.squarings {
                 base *= base;
-                n >>= 1;
             }
-            out
+            match self.odd {
+                1 => base,
+                3 => base * base * base,
+                n => {
+                    // By squaring.
+                    let (mut out, mut n) = (base, n >> 1);
+                    while n > 0 {
+                        base *= base;
+                        if n & 1 == 1 {
+                            out *= base;
+                        }
+                        n >>= 1;
+                    }
+                    out
+                }
+            }
         }
     }
     impl Exponent for Real {
@@ -100,7 +126,7 @@ enum Power {
     Two,
     Three,
     Four,
-    Int(u32),
+    Int(exponent::Int),
     Real(f64),
 }
 
@@ -113,7 +139,7 @@ impl Exponent for Power {
             Power::Two => exponent::Two.abs_pow(x),
             Power::Three => exponent::Three.abs_pow(x),
             Power::Four => exponent::Four.abs_pow(x),
-            Power::Int(n) => exponent::Int(n).abs_pow(x),
+            Power::Int(n) => n.abs_pow(x),
             Power::Real(p) => exponent::Real(p).abs_pow(x),
         }
     }
@@ -146,7 +172,7 @@ impl PowerLaw {
                 2 => Power::Two,
                 3 => Power::Three,
                 4 => Power::Four,
-                n => Power::Int(n),
+                n => Power::Int(exponent::Int::new(n)),
             };
             (power, phi * (2.0 / length).powf(p))
         } else {
@@ -310,7 +336,7 @@ impl NonlinearTld {
             Power::Two => fixed(self, exponent::Two, job),
             Power::Three => fixed(self, exponent::Three, job),
             Power::Four => fixed(self, exponent::Four, job),
-            Power::Int(n) => fixed(self, exponent::Int(n), job),
+            Power::Int(n) => fixed(self, n, job),
             Power::Real(p) => fixed(self, exponent::Real(p), job),
         }
     }
@@ -464,6 +490,20 @@ mod tests {
         }
         // The local frequency at rest is omega_f.
         assert!((Rhs::stiffness(&m, 0.0, &[0.0; state::DIM]) - 5.6).abs() < 1e-12);
+    }
+
+    #[test]
+    fn integer_powers_by_squaring() {
+        for n in 1..=64 {
+            for x in [-1.7, -0.93, -1e-3, 0.0, 2e-4, 0.31, 0.999, 1.0, 1.25] {
+                let got = exponent::Int::new(n).abs_pow(x);
+                let want = f64::abs(x).powi(n as i32);
+                assert!(
+                    (got - want).abs() <= 1e-15 * f64::from(n) * want,
+                    "|{x}|^{n}: {got} vs {want}"
+                );
+            }
+        }
     }
 
     #[test]
