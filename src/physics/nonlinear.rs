@@ -38,9 +38,10 @@ pub mod exponent {
     }
 
     impl Int {
-        /// |x|^n, n > 0.
+        /// |x|^n.
         pub fn new(n: u32) -> Self {
-            let squarings = n.trailing_zeros().min(31);
+            // n = 0 leaves odd = 0, answered as |x|^0 = 1.
+            let squarings = if n == 0 { 0 } else { n.trailing_zeros() };
             Int {
                 squarings,
                 odd: n >> squarings,
@@ -92,6 +93,7 @@ pub mod exponent {
                 base *= base;
             }
             match self.odd {
+                0 => 1.0,
                 1 => base,
                 3 => base * base * base,
                 n => {
@@ -494,7 +496,7 @@ mod tests {
 
     #[test]
     fn integer_powers_by_squaring() {
-        for n in 1..=64 {
+        for n in 0..=64 {
             for x in [-1.7, -0.93, -1e-3, 0.0, 2e-4, 0.31, 0.999, 1.0, 1.25] {
                 let got = exponent::Int::new(n).abs_pow(x);
                 let want = f64::abs(x).powi(n as i32);
