@@ -314,6 +314,7 @@ impl Integrator {
             Integrator::DormandPrince853(m) => m.integrate(model, 0.0, h, z),
             Integrator::Sdirk4(m) => m.integrate(model, 0.0, h, z),
             Integrator::Auto(m) => m.integrate(model, 0.0, h, z),
+            // Taken directly by `integrate`; here only to keep the match whole.
             Integrator::Rk4(m) => m.integrate(model, 0.0, h, z),
         });
         if outcome.is_err() {

@@ -805,3 +805,48 @@ impl Instance {
         Ok(self.time)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table behind fmi2SetReal's fast path must agree with the full check: every variable
+    /// in it takes any finite value, at its own position, in every phase that allows sets, and
+    /// refuses a non-finite one; and every Real input the full check would take that way is in it.
+    #[test]
+    fn free_real_inputs_are_what_the_full_check_accepts() {
+        let mut inst = Instance::new(c"t".into(), Logger::new(None, std::ptr::null_mut()), false);
+        let mut listed = 0;
+        for phase in [
+            Phase::Instantiated,
+            Phase::InitializationMode,
+            Phase::StepComplete,
+        ] {
+            assert_ne!(phase.bit() & allow::SET, 0);
+            inst.phase = phase;
+            for var in VARIABLES {
+                let r = var.vr;
+                let full = |v: f64| inst.check_set(r, v, VarType::Real, "t").ok();
+                let any_finite = [f64::MAX, -f64::MAX, 0.0, 5e-324, -1.5e7]
+                    .iter()
+                    .all(|&v| full(v) == index_of(r));
+                match free_real_input(r) {
+                    Some(index) => {
+                        listed += 1;
+                        assert_eq!(Some(index), index_of(r), "{}", var.name);
+                        assert!(any_finite, "{} in {phase:?}", var.name);
+                        for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                            assert_eq!(full(v), None, "{} = {v}", var.name);
+                        }
+                    }
+                    None => assert!(
+                        !(any_finite && var.causality == Causality::Input),
+                        "{} is a Real input the full check takes as any finite value: list it",
+                        var.name
+                    ),
+                }
+            }
+        }
+        assert!(listed >= 3, "base.a, base.v and base.x at least");
+    }
+}

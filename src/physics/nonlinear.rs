@@ -132,18 +132,40 @@ enum Power {
     Real(f64),
 }
 
+/// Work on an exponent whose kind is chosen at run time ([`Power::dispatch`]).
+trait KindJob {
+    type Output;
+    fn run<E: Exponent>(self, exponent: E) -> Self::Output;
+}
+
+impl Power {
+    /// Run `job` on this exponent as its kind: the one place where a Power becomes a kind.
+    #[inline(always)]
+    fn dispatch<J: KindJob>(self, job: J) -> J::Output {
+        match self {
+            Power::Zero => job.run(exponent::Zero),
+            Power::One => job.run(exponent::One),
+            Power::Two => job.run(exponent::Two),
+            Power::Three => job.run(exponent::Three),
+            Power::Four => job.run(exponent::Four),
+            Power::Int(n) => job.run(n),
+            Power::Real(p) => job.run(exponent::Real(p)),
+        }
+    }
+}
+
 impl Exponent for Power {
     #[inline]
     fn abs_pow(self, x: f64) -> f64 {
-        match self {
-            Power::Zero => exponent::Zero.abs_pow(x),
-            Power::One => exponent::One.abs_pow(x),
-            Power::Two => exponent::Two.abs_pow(x),
-            Power::Three => exponent::Three.abs_pow(x),
-            Power::Four => exponent::Four.abs_pow(x),
-            Power::Int(n) => n.abs_pow(x),
-            Power::Real(p) => exponent::Real(p).abs_pow(x),
+        struct At(f64);
+        impl KindJob for At {
+            type Output = f64;
+            #[inline(always)]
+            fn run<E: Exponent>(self, exponent: E) -> f64 {
+                exponent.abs_pow(self.0)
+            }
         }
+        self.dispatch(At(x))
     }
 }
 
@@ -329,18 +351,21 @@ impl NonlinearTld {
     /// caller: behind a call, the integrator's state would pass through memory both ways.
     #[inline(always)]
     pub fn with_exponent<J: RhsJob>(&self, job: J) -> J::Output {
-        fn fixed<E: Exponent, J: RhsJob>(model: &NonlinearTld, exponent: E, job: J) -> J::Output {
-            job.run(&Fixed { model, exponent })
+        struct Compiled<'a, J> {
+            model: &'a NonlinearTld,
+            job: J,
         }
-        match self.stiffness.power {
-            Power::Zero => fixed(self, exponent::Zero, job),
-            Power::One => fixed(self, exponent::One, job),
-            Power::Two => fixed(self, exponent::Two, job),
-            Power::Three => fixed(self, exponent::Three, job),
-            Power::Four => fixed(self, exponent::Four, job),
-            Power::Int(n) => fixed(self, n, job),
-            Power::Real(p) => fixed(self, exponent::Real(p), job),
+        impl<J: RhsJob> KindJob for Compiled<'_, J> {
+            type Output = J::Output;
+            #[inline(always)]
+            fn run<E: Exponent>(self, exponent: E) -> J::Output {
+                self.job.run(&Fixed {
+                    model: self.model,
+                    exponent,
+                })
+            }
         }
+        self.stiffness.power.dispatch(Compiled { model: self, job })
     }
 }
 
