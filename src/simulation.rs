@@ -751,37 +751,36 @@ impl Simulation {
                 model.c = 2.0 * zeta * omega_f;
                 model.base.t0 = 0.0;
                 model.base.a = [inputs.a, a1, a2];
+                let v0 = y[state::V];
                 // model = Auto: the exact linear solution while the hardening is below the
-                // threshold.
-                if let Some((threshold, mode)) = linear_below.as_mut()
-                    && let Some(next) = linear_step(model, *threshold, mode, zeta, y, h, &base)
-                {
-                    let impulse = mass * (-(next[state::V] - y[state::V]) - base.integral(h));
-                    *y = next;
-                    return self.finish_step(
-                        zeta,
-                        tracker,
-                        impulse * inv_h,
+                // threshold; otherwise the integrator.
+                let linear = match linear_below.as_mut() {
+                    Some((threshold, mode)) => {
+                        linear_step(model, *threshold, mode, zeta, y, h, &base)
+                    }
+                    None => None,
+                };
+                let stats = match linear {
+                    Some(next) => {
+                        *y = next;
                         SolveStats {
                             accepted: 1,
                             ..SolveStats::default()
-                        },
-                    );
-                }
-                let v0 = y[state::V];
-                let outcome = model.with_exponent(Interval {
-                    integrator,
-                    t,
-                    h,
-                    y,
-                    limit,
-                });
-                let stats = match outcome {
-                    Ok(stats) => stats,
-                    Err(e) => {
-                        (model.c, model.base) = previous;
-                        return Err(e);
+                        }
                     }
+                    None => match model.with_exponent(Interval {
+                        integrator,
+                        t,
+                        h,
+                        y,
+                        limit,
+                    }) {
+                        Ok(stats) => stats,
+                        Err(e) => {
+                            (model.c, model.base) = previous;
+                            return Err(e);
+                        }
+                    },
                 };
                 (stats, mass * (-(y[state::V] - v0) - base.integral(h)))
             }
