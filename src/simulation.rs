@@ -8,7 +8,7 @@ use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::physics::linear::{Mode, ModeState};
 use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, RhsJob, state};
 use crate::physics::slamming::{SlamState, Slamming};
-use crate::solver::{Auto, Dop853, Dopri5, Rhs, Rk4, Sdirk4, SolveError, SolveStats};
+use crate::solver::{Auto, Dop853, Dopri5, Rhs, Rk4, Rk5, Rk8, Sdirk4, SolveError, SolveStats};
 
 /// Where the excitation amplitude of the amplitude laws comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,8 +30,18 @@ pub enum Method {
         rtol: f64,
         max_step: f64,
     },
-    /// Classical RK4 with internal steps <= `step`.
-    Rk4 { step: f64 },
+    /// An explicit formula with equal internal steps <= `step`, no error control.
+    Fixed { formula: FixedFormula, step: f64 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FixedFormula {
+    /// Classical fourth-order Runge-Kutta (4 evaluations per step).
+    Rk4,
+    /// The fifth-order solution of Dormand-Prince 5(4) (6 evaluations).
+    Rk5,
+    /// The eighth-order solution of DOP853 (12 evaluations).
+    Rk8,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -273,6 +283,8 @@ enum Integrator {
     Sdirk4(Sdirk4<{ state::DIM }>),
     Auto(Auto<{ state::DIM }>),
     Rk4(Rk4),
+    Rk5(Rk5),
+    Rk8(Rk8),
 }
 
 impl Integrator {
@@ -314,6 +326,8 @@ impl Integrator {
             Integrator::DormandPrince853(m) => m.integrate(model, 0.0, h, z),
             Integrator::Sdirk4(m) => m.integrate(model, 0.0, h, z),
             Integrator::Auto(m) => m.integrate(model, 0.0, h, z),
+            Integrator::Rk5(m) => m.integrate(model, 0.0, h, z),
+            Integrator::Rk8(m) => m.integrate(model, 0.0, h, z),
             // Taken directly by `integrate`; here only to keep the match whole.
             Integrator::Rk4(m) => m.integrate(model, 0.0, h, z),
         });
@@ -330,7 +344,7 @@ impl Integrator {
             Integrator::DormandPrince853(m) => [m.carried_step(), 0.0, 0.0],
             Integrator::Sdirk4(m) => [m.carried_step(), 0.0, 0.0],
             Integrator::Auto(m) => m.memory(),
-            Integrator::Rk4(_) => [0.0; 3],
+            Integrator::Rk4(_) | Integrator::Rk5(_) | Integrator::Rk8(_) => [0.0; 3],
         }
     }
 
@@ -340,7 +354,7 @@ impl Integrator {
             Integrator::DormandPrince853(m) => m.set_carried_step(h[0]),
             Integrator::Sdirk4(m) => m.set_carried_step(h[0]),
             Integrator::Auto(m) => m.set_memory(h),
-            Integrator::Rk4(_) => {}
+            Integrator::Rk4(_) | Integrator::Rk5(_) | Integrator::Rk8(_) => {}
         }
     }
 }
@@ -584,7 +598,7 @@ impl Simulation {
                             ModelKind::NonlinearAuto { threshold } => {
                                 let tolerance = match config.method {
                                     Method::Adaptive { rtol, .. } => rtol,
-                                    Method::Rk4 { .. } => 1e-10,
+                                    Method::Fixed { .. } => 1e-10,
                                 };
                                 let threshold = if threshold > 0.0 {
                                     threshold
@@ -696,10 +710,14 @@ impl Simulation {
                     AdaptiveKind::Auto => Integrator::Auto(Auto::new(rtol, scale, max_step, n)),
                 }
             }
-            Method::Rk4 { step } => Integrator::Rk4(Rk4 {
-                max_step: step,
-                max_steps: config.max_substeps,
-            }),
+            Method::Fixed { formula, step } => {
+                let n = config.max_substeps;
+                match formula {
+                    FixedFormula::Rk4 => Integrator::Rk4(Rk4::new(step, n)),
+                    FixedFormula::Rk5 => Integrator::Rk5(Rk5::new(step, n)),
+                    FixedFormula::Rk8 => Integrator::Rk8(Rk8::new(step, n)),
+                }
+            }
         }
     }
 
@@ -1245,7 +1263,18 @@ mod tests {
             adaptive(AdaptiveKind::DormandPrince853),
             adaptive(AdaptiveKind::Sdirk4),
             adaptive(AdaptiveKind::Auto),
-            Method::Rk4 { step: 0.01 },
+            Method::Fixed {
+                formula: FixedFormula::Rk4,
+                step: 0.01,
+            },
+            Method::Fixed {
+                formula: FixedFormula::Rk5,
+                step: 0.01,
+            },
+            Method::Fixed {
+                formula: FixedFormula::Rk8,
+                step: 0.01,
+            },
         ] {
             // Linear (phi = 0), so that a huge input is integrated without trouble.
             let cfg = Config {

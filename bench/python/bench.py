@@ -24,6 +24,7 @@ import json
 import math
 import os
 import platform
+import re
 import shutil
 import subprocess
 import sys
@@ -375,15 +376,18 @@ class FmuInfo:
     def physics_tokens(self, p: R.TLD):
         return [self.token(k, v) for k, v in self.physics_params(p).items()]
 
-    def solver_settings(self, dt, quick):
+    def solver_settings(self, dt, quick, omega_f):
         """[(method label, setting label, tokens)] for every item of the `solver` enumeration:
-        fixed-step items sweep solver.fixed_step = dt/n, the others solver.tolerance."""
+        fixed-step items sweep solver.fixed_step = dt/n (n down to where the formula of the
+        item's order, RK<order>, reaches round-off), the others solver.tolerance."""
         out = [("default", "defaults", [])]
         for name, val, desc in self.items("solver"):
             fixed = "fixed" in desc.lower() and "tolerance" not in desc.lower()
             sel = self.token("solver", val)
             if fixed:
-                for n in rk4_substeps(dt, quick):
+                m = re.fullmatch(r"RK(\d+)", name)
+                order = int(m.group(1)) if m else 4
+                for n in rk4_substeps(dt, quick, h_min=round_off_step(order, omega_f)):
                     out.append((name, f"n={n}", [sel, self.token("solver.fixed_step", dt / n)]))
             else:
                 tols = TOLS if not quick else [1e-6, 1e-10]
@@ -397,9 +401,16 @@ class FmuInfo:
         return out
 
 
-def rk4_substeps(dt, quick, cap=N_MAX_RK4):
+def round_off_step(order, omega_f):
+    """The substep below which a formula of this order has nothing left to gain: omega_f h =
+    1e-14^(1/order) (its local error ~ (omega_f h)^order at round-off), at least H_MIN_RK4."""
+    return max(H_MIN_RK4, 1e-14 ** (1.0 / order) / omega_f)
+
+
+def rk4_substeps(dt, quick, cap=N_MAX_RK4, h_min=H_MIN_RK4):
+    """n = 1, 2, 4, ... while dt/n >= h_min (n = 1 always)."""
     ns, n = [], 1
-    while dt / n >= H_MIN_RK4 * (1 - 1e-9) and n <= (4 if quick else cap):
+    while (n == 1 or dt / n >= h_min * (1 - 1e-9)) and n <= (4 if quick else cap):
         ns.append(n)
         n *= 2
     return ns
@@ -433,7 +444,7 @@ def run_native(fi: FmuInfo, sc: Scene, dt, a, refs, quick, tmp: Path):
         lines.append(f"input {f} {n}")
     phys = fi.physics_tokens(p) if sc.fmu_physics else []
     meta = {}
-    for method, setting, toks in fi.solver_settings(dt, quick):
+    for method, setting, toks in fi.solver_settings(dt, quick, p.omega_f):
         rid = f"fmu_{method}_{setting}".replace("=", "").replace("+", "")
         meta[rid] = dict(impl="TLD.fmu", method=method, setting=setting)
         lines.append(f"run {rid} fmu {' '.join(phys + toks)}")
@@ -789,6 +800,8 @@ def plots(scenes, rows, outdir: Path, tag):
     style = {
         ("TLD.fmu", "DormandPrince45"): dict(color="C0", marker="o"),
         ("TLD.fmu", "RK4"): dict(color="C1", marker="s"),
+        ("TLD.fmu", "RK5"): dict(color="darkgoldenrod", marker="p"),
+        ("TLD.fmu", "RK8"): dict(color="teal", marker="h"),
         ("Rust baseline", "DP45"): dict(color="C0", marker="o", ls="--", mfc="none"),
         ("Rust baseline", "RK4"): dict(color="C1", marker="s", ls="--", mfc="none"),
         ("scipy solve_ivp", "DOP853"): dict(color="C2", marker="^"),

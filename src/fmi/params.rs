@@ -5,8 +5,8 @@ use super::vars::{Causality, VARIABLES, VR_INDEX, VarType, index_of, vr};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::simulation::{
-    AdaptiveKind, AmplitudeSource, Config, Derived, Inputs, Method, ModelKind, Output,
-    SlammingParams,
+    AdaptiveKind, AmplitudeSource, Config, Derived, FixedFormula, Inputs, Method, ModelKind,
+    Output, SlammingParams,
 };
 
 /// Values of all variables, in the order of `VARIABLES` (integers and enumerations as f64).
@@ -122,13 +122,17 @@ impl Values {
             rtol,
             max_step: g(vr::SOLVER_MAX_STEP),
         };
+        let fixed = |formula| Method::Fixed {
+            formula,
+            step: g(vr::SOLVER_FIXED_STEP),
+        };
         let method = match self.option(vr::SOLVER, vr::SOLVER_ID) as i64 {
-            2 => Method::Rk4 {
-                step: g(vr::SOLVER_FIXED_STEP),
-            },
+            2 => fixed(FixedFormula::Rk4),
             3 => adaptive(AdaptiveKind::Sdirk4),
             4 => adaptive(AdaptiveKind::Auto),
             5 => adaptive(AdaptiveKind::DormandPrince853),
+            6 => fixed(FixedFormula::Rk5),
+            7 => fixed(FixedFormula::Rk8),
             _ => adaptive(AdaptiveKind::DormandPrince),
         };
         let model = match self.option(vr::MODEL, vr::MODEL_ID) as i64 {

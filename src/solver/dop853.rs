@@ -2,6 +2,7 @@
 //! error estimate, for tight tolerances where the 5(4) pair needs many more steps.
 
 use super::adaptive::{Adaptive, Controls, Embedded};
+use super::fixed::{FixedStep, Formula};
 use super::{Rhs, SolveStats, all_finite};
 
 // The DOP853 tableau of Hairer, Norsett & Wanner (Solving ODEs I, II.10): 12 stages of
@@ -227,6 +228,75 @@ const E3: [f64; S + 1] = [
 /// Adaptive Dormand-Prince 8(5,3).
 pub type Dop853<const N: usize> = Adaptive<N, Dop853Stages<N>>;
 
+/// The pair's eighth-order solution with a fixed step: twelve evaluations, no error estimate.
+pub type Rk8 = FixedStep<DormandPrince8>;
+
+/// sum_j w_j k_j[i] over the nonzero weights, in order: the tableau is a constant, so once
+/// unrolled the zero terms cost nothing.
+#[inline(always)]
+fn weighted<const N: usize>(w: &[f64], k: &[[f64; N]], i: usize) -> f64 {
+    let mut acc = 0.0;
+    for (wj, kj) in w.iter().zip(k) {
+        if *wj != 0.0 {
+            acc += wj * kj[i];
+        }
+    }
+    acc
+}
+
+/// Slope k[J] (J = 1 to 11: stages 2 to 12) of a step of `h` from (t, y), from k[..J]. `J` is a
+/// constant so that each stage is compiled with its own row of the tableau.
+#[inline(always)]
+fn stage<const J: usize, const N: usize, F: Rhs<N>>(
+    f: &F,
+    t: f64,
+    y: &[f64; N],
+    h: f64,
+    k: &mut [[f64; N]; S + 1],
+) {
+    let tmp: [f64; N] = std::array::from_fn(|i| y[i] + h * weighted(&A[J][..J], &k[..J], i));
+    f.eval(t + C[J] * h, &tmp, &mut k[J]);
+}
+
+/// Stages 2 to 12 of a step of `h` from (t, y) into k[1..S], k[0] being the slope at (t, y),
+/// and the eighth-order solution.
+#[inline(always)]
+fn eighth_order<const N: usize, F: Rhs<N>>(
+    f: &F,
+    t: f64,
+    y: &[f64; N],
+    h: f64,
+    k: &mut [[f64; N]; S + 1],
+) -> [f64; N] {
+    stage::<1, N, F>(f, t, y, h, k);
+    stage::<2, N, F>(f, t, y, h, k);
+    stage::<3, N, F>(f, t, y, h, k);
+    stage::<4, N, F>(f, t, y, h, k);
+    stage::<5, N, F>(f, t, y, h, k);
+    stage::<6, N, F>(f, t, y, h, k);
+    stage::<7, N, F>(f, t, y, h, k);
+    stage::<8, N, F>(f, t, y, h, k);
+    stage::<9, N, F>(f, t, y, h, k);
+    stage::<10, N, F>(f, t, y, h, k);
+    stage::<11, N, F>(f, t, y, h, k);
+    std::array::from_fn(|i| y[i] + h * weighted(&B, &k[..S], i))
+}
+
+/// The eighth-order formula of DOP853 on its own (twelve evaluations).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DormandPrince8;
+
+impl Formula for DormandPrince8 {
+    const EVALS: u64 = S as u64;
+
+    #[inline(always)]
+    fn step<const N: usize, F: Rhs<N>>(f: &F, t: f64, h: f64, z: &[f64; N]) -> [f64; N] {
+        let mut k = [[0.0; N]; S + 1];
+        f.eval(t, z, &mut k[0]);
+        eighth_order(f, t, z, h, &mut k)
+    }
+}
+
 /// The stages of DOP853; the last slope is kept between steps (first same as last).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dop853Stages<const N: usize> {
@@ -260,22 +330,7 @@ impl<const N: usize> Embedded<N> for Dop853Stages<N> {
         ctl: &Controls<N>,
         stats: &mut SolveStats,
     ) -> bool {
-        let mut tmp = [0.0; N];
-        for s in 1..S {
-            for i in 0..N {
-                let acc: f64 = A[s][..s]
-                    .iter()
-                    .zip(&self.k[..s])
-                    .map(|(a, k)| a * k[i])
-                    .sum();
-                tmp[i] = y[i] + h * acc;
-            }
-            f.eval(t + C[s] * h, &tmp, &mut self.k[s]);
-        }
-        for i in 0..N {
-            let acc: f64 = B.iter().zip(&self.k[..S]).map(|(b, k)| b * k[i]).sum();
-            y_new[i] = y[i] + h * acc;
-        }
+        *y_new = eighth_order(f, t, y, h, &mut self.k);
         f.eval(t + h, y_new, &mut self.k[S]);
         stats.evaluations += S as u64;
         // The combined estimate of Hairer's DOP853: err5^2 / sqrt(err5^2 + 0.01 err3^2), in the

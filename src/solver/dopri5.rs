@@ -2,6 +2,7 @@
 //! (Hairer, Norsett & Wanner, Solving ODEs I, section II.4 and II.5).
 
 use super::adaptive::{Adaptive, Controls, Embedded};
+use super::fixed::{FixedStep, Formula};
 use super::{Rhs, SolveStats, all_finite};
 
 // Butcher tableau.
@@ -40,6 +41,63 @@ const E7: f64 = -1.0 / 40.0;
 /// Adaptive Dormand-Prince 5(4).
 pub type Dopri5<const N: usize> = Adaptive<N, DormandPrince<N>>;
 
+/// The pair's fifth-order solution with a fixed step: six evaluations, no error estimate.
+pub type Rk5 = FixedStep<DormandPrince5>;
+
+/// Stages 2 to 6 of a step of `hs` from (t, z) with slope `k1` there: the slopes the error
+/// estimate needs besides k1 (k3 to k6) and the fifth-order solution.
+#[inline(always)]
+fn fifth_order<const N: usize, F: Rhs<N>>(
+    f: &F,
+    t: f64,
+    z: &[f64; N],
+    hs: f64,
+    k1: &[f64; N],
+) -> ([[f64; N]; 4], [f64; N]) {
+    let (mut k2, mut k3, mut k4, mut k5, mut k6) =
+        ([0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+    let mut tmp = [0.0; N];
+    for i in 0..N {
+        tmp[i] = z[i] + hs * A21 * k1[i];
+    }
+    f.eval(t + C2 * hs, &tmp, &mut k2);
+    for i in 0..N {
+        tmp[i] = z[i] + hs * (A31 * k1[i] + A32 * k2[i]);
+    }
+    f.eval(t + C3 * hs, &tmp, &mut k3);
+    for i in 0..N {
+        tmp[i] = z[i] + hs * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
+    }
+    f.eval(t + C4 * hs, &tmp, &mut k4);
+    for i in 0..N {
+        tmp[i] = z[i] + hs * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
+    }
+    f.eval(t + C5 * hs, &tmp, &mut k5);
+    for i in 0..N {
+        tmp[i] = z[i] + hs * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
+    }
+    f.eval(t + hs, &tmp, &mut k6);
+    let y = std::array::from_fn(|i| {
+        z[i] + hs * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
+    });
+    ([k3, k4, k5, k6], y)
+}
+
+/// The fifth-order formula of the Dormand-Prince pair on its own (six evaluations).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DormandPrince5;
+
+impl Formula for DormandPrince5 {
+    const EVALS: u64 = 6;
+
+    #[inline(always)]
+    fn step<const N: usize, F: Rhs<N>>(f: &F, t: f64, h: f64, z: &[f64; N]) -> [f64; N] {
+        let mut k1 = [0.0; N];
+        f.eval(t, z, &mut k1);
+        fifth_order(f, t, z, h, &k1).1
+    }
+}
+
 /// The Dormand-Prince 5(4) pair's stages; k1 is kept between steps (first same as last).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DormandPrince<const N: usize> {
@@ -75,34 +133,9 @@ impl<const N: usize> Embedded<N> for DormandPrince<N> {
         _ctl: &Controls<N>,
         stats: &mut SolveStats,
     ) -> bool {
+        let ([k3, k4, k5, k6], y) = fifth_order(f, t, z, hs, &self.k1);
+        *y_new = y;
         let k1 = &self.k1;
-        let (mut k2, mut k3, mut k4, mut k5, mut k6) =
-            ([0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N]);
-        let mut tmp = [0.0; N];
-        for i in 0..N {
-            tmp[i] = z[i] + hs * A21 * k1[i];
-        }
-        f.eval(t + C2 * hs, &tmp, &mut k2);
-        for i in 0..N {
-            tmp[i] = z[i] + hs * (A31 * k1[i] + A32 * k2[i]);
-        }
-        f.eval(t + C3 * hs, &tmp, &mut k3);
-        for i in 0..N {
-            tmp[i] = z[i] + hs * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
-        }
-        f.eval(t + C4 * hs, &tmp, &mut k4);
-        for i in 0..N {
-            tmp[i] = z[i] + hs * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
-        }
-        f.eval(t + C5 * hs, &tmp, &mut k5);
-        for i in 0..N {
-            tmp[i] =
-                z[i] + hs * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
-        }
-        f.eval(t + hs, &tmp, &mut k6);
-        for i in 0..N {
-            y_new[i] = z[i] + hs * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i]);
-        }
         f.eval(t + hs, y_new, &mut self.k7);
         stats.evaluations += 6;
         let k7 = &self.k7;

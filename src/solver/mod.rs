@@ -5,14 +5,14 @@ mod adaptive;
 mod auto;
 mod dop853;
 mod dopri5;
-mod rk4;
+mod fixed;
 mod sdirk4;
 
 pub use adaptive::{Adaptive, Controls, Embedded};
 pub use auto::Auto;
-pub use dop853::{Dop853, Dop853Stages};
-pub use dopri5::{Dopri5, DormandPrince};
-pub use rk4::Rk4;
+pub use dop853::{Dop853, Dop853Stages, DormandPrince8, Rk8};
+pub use dopri5::{Dopri5, DormandPrince, DormandPrince5, Rk5};
+pub use fixed::{Classical, FixedStep, Formula, Rk4};
 pub use sdirk4::{Sdirk4, Sdirk4Stages};
 
 /// y' = f(t, y) for a state of fixed size N.
@@ -247,21 +247,30 @@ mod tests {
         assert!(error_after(&y, w, 400.0 * h) < 1e-3);
     }
 
+    /// Each fixed-step formula converges at its order: halving the step divides the error of
+    /// a run over several periods by 2^order (a wrong coefficient drops the order).
     #[test]
-    fn rk4_is_fourth_order() {
-        let w = 5.6389;
-        let run = |step: f64| {
-            let mut y = [1.0, 0.0];
-            Rk4 {
-                max_step: step,
-                max_steps: 1_000_000,
-            }
-            .integrate(&Oscillator(w), 0.0, 5.0, &mut y)
-            .expect("run");
-            error_after(&y, w, 5.0)
-        };
-        let ratio = run(0.01) / run(0.005);
-        assert!((ratio - 16.0).abs() < 1.0, "error ratio {ratio}");
+    fn fixed_step_formulas_converge_at_their_order() {
+        fn order<M: Formula>(coarse: f64) -> f64 {
+            let w = 5.6389;
+            let run = |step: f64| {
+                let mut y = [1.0, 0.0];
+                let stats = FixedStep::<M>::new(step, 1_000_000)
+                    .integrate(&Oscillator(w), 0.0, 5.0, &mut y)
+                    .expect("run");
+                assert_eq!(stats.evaluations, M::EVALS * stats.accepted);
+                error_after(&y, w, 5.0)
+            };
+            (run(coarse) / run(0.5 * coarse)).log2()
+        }
+        // steps where the error is far above round-off
+        for (name, measured, want) in [
+            ("RK4", order::<Classical>(0.01), 4.0),
+            ("RK5", order::<DormandPrince5>(0.02), 5.0),
+            ("RK8", order::<DormandPrince8>(0.1), 8.0),
+        ] {
+            assert!((measured - want).abs() < 0.3, "{name}: order {measured}");
+        }
     }
 
     #[test]
@@ -274,11 +283,7 @@ mod tests {
             "{r:?}"
         );
         assert_eq!(y, [1.0, 0.0]);
-        let r = Rk4 {
-            max_step: 1e-3,
-            max_steps: 10,
-        }
-        .integrate(&Oscillator(5.0), 0.0, 1.0, &mut y);
+        let r = Rk4::new(1e-3, 10).integrate(&Oscillator(5.0), 0.0, 1.0, &mut y);
         assert!(matches!(r, Err(SolveError::TooManySteps { .. })));
         assert_eq!(y, [1.0, 0.0]);
     }

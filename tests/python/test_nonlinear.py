@@ -113,20 +113,28 @@ def test_base_shear_feeds_through_base_a(slave_factory):
     assert f0 == pytest.approx(float(p.force(0.01, 0.0)), rel=1e-13)
 
 
-def test_rk4_solver(slave_factory):
-    # solver = RK4 with a fixed internal step of 1 ms, communication step 10 ms: the global
-    # error of RK4 is ~ (h w)^4 ~ 1e-9 here, so the 1e-6 requirement has wide margin, while a
-    # broken RK4 (wrong weights: first or second order) would miss it by orders of magnitude
+@pytest.mark.parametrize("solver,order,dt,fixed_step", [
+    (R.SOLVER_RK4, 4, 0.01, 2e-3), (R.SOLVER_RK5, 5, 0.02, 0.02), (R.SOLVER_RK8, 8, 0.1, 0.1)],
+    ids=["RK4", "RK5", "RK8"])
+def test_fixed_step_solvers(slave_factory, solver, order, dt, fixed_step):
+    # The fixed-step solvers against the reference at solver.fixed_step h and h/2 (each
+    # communication step cut into equal substeps): the error falls by 2^order, and stays far
+    # above the reference's own (its substeps of 1 ms), so that a wrong formula (lower order)
+    # or a wrong substep count shows.
     p = R.TLD()
-    dt, n = 0.01, 2000
+    n = int(round(20.0 / dt))
     bx, bv, ba = R.harmonic_base(1.05 * p.omega_f, 0.005, dt * np.arange(n))
-    s = slave_factory(quiet=True)
-    s.initialize({**p.fmu_parameters(), "solver": R.SOLVER_RK4, "solver.fixed_step": 1e-3})
-    out = s.run(dt, {"base.x": bx, "base.v": bv, "base.a": ba}, ["slosh.x"])
-    ref = R.simulate_held(p, dt, ba, substeps=4)
-    e = R.rel_err(out["slosh.x"], ref.x)
-    print(f"RK4 error {e:.2e}")
-    assert e < 1e-6
+    ref = R.simulate_held(p, dt, ba, substeps=int(round(dt / 1e-3)))
+    errs = []
+    for h in (fixed_step, fixed_step / 2):
+        s = slave_factory(quiet=True)
+        s.initialize({**p.fmu_parameters(), "solver": solver, "solver.fixed_step": h})
+        out = s.run(dt, {"base.x": bx, "base.v": bv, "base.a": ba}, ["slosh.x"])
+        errs.append(R.rel_err(out["slosh.x"], ref.x))
+    measured = np.log2(errs[0] / errs[1])
+    print(f"solver {solver}: errors {errs[0]:.2e}, {errs[1]:.2e}, order {measured:.2f}")
+    assert errs[0] < 1e-6 and errs[1] > 1e3 * 1e-15
+    assert abs(measured - order) < 0.5
 
 
 def test_setup_experiment_tolerance(slave_factory):
