@@ -8,7 +8,9 @@ use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::physics::linear::{Mode, ModeState};
 use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, RhsJob, state};
 use crate::physics::slamming::{SlamState, Slamming};
-use crate::solver::{Auto, Dop853, Dopri5, Rhs, Rk4, Rk5, Rk8, Sdirk4, SolveError, SolveStats};
+use crate::solver::{
+    Auto, Dop853, Dopri5, ExpRk4, OscillatorSplit, Rk4, Rk5, Rk8, Sdirk4, SolveError, SolveStats,
+};
 
 /// Where the excitation amplitude of the amplitude laws comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,6 +44,9 @@ pub enum FixedFormula {
     Rk5,
     /// The eighth-order solution of DOP853 (12 evaluations).
     Rk8,
+    /// Exponential (Lawson) RK4: the linear oscillator by its exact flow, RK4 on the rest
+    /// (4 evaluations).
+    ExpRk4,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -285,13 +290,14 @@ enum Integrator {
     Rk4(Rk4),
     Rk5(Rk5),
     Rk8(Rk8),
+    ExpRk4(ExpRk4),
 }
 
 impl Integrator {
     /// Advance `y` over (0, h), the interval that starts at time `t`, refusing a state whose
     /// displacement leaves `limit` (a runaway). On error `y` and the integrator are unchanged.
     #[inline]
-    fn integrate<F: Rhs<{ state::DIM }>>(
+    fn integrate<F: OscillatorSplit<{ state::DIM }>>(
         &mut self,
         model: &F,
         t: f64,
@@ -300,8 +306,10 @@ impl Integrator {
         limit: f64,
     ) -> Result<SolveStats, StepError> {
         match self {
-            // RK4 carries nothing from one interval to the next: nothing to put back.
+            // The cheapest steps, inline. They carry nothing from one interval to the next
+            // (ExpRK4's flows are derived from the configuration): nothing to put back.
             Integrator::Rk4(m) => checked(y, t, limit, |z| m.integrate(model, 0.0, h, z)),
+            Integrator::ExpRk4(m) => checked(y, t, limit, |z| m.integrate(model, 0.0, h, z)),
             other => other.integrate_any(model, t, h, y, limit),
         }
     }
@@ -310,7 +318,7 @@ impl Integrator {
     /// kind of exponent, made it a function of some 60 kB whose stack traffic slowed the
     /// cheapest steps (RK4, one substep: 5 % of the whole doStep).
     #[inline(never)]
-    fn integrate_any<F: Rhs<{ state::DIM }>>(
+    fn integrate_any<F: OscillatorSplit<{ state::DIM }>>(
         &mut self,
         model: &F,
         t: f64,
@@ -330,6 +338,7 @@ impl Integrator {
             Integrator::Rk8(m) => m.integrate(model, 0.0, h, z),
             // Taken directly by `integrate`; here only to keep the match whole.
             Integrator::Rk4(m) => m.integrate(model, 0.0, h, z),
+            Integrator::ExpRk4(m) => m.integrate(model, 0.0, h, z),
         });
         if outcome.is_err() {
             self.set_memory(carried);
@@ -344,7 +353,10 @@ impl Integrator {
             Integrator::DormandPrince853(m) => [m.carried_step(), 0.0, 0.0],
             Integrator::Sdirk4(m) => [m.carried_step(), 0.0, 0.0],
             Integrator::Auto(m) => m.memory(),
-            Integrator::Rk4(_) | Integrator::Rk5(_) | Integrator::Rk8(_) => [0.0; 3],
+            Integrator::Rk4(_)
+            | Integrator::Rk5(_)
+            | Integrator::Rk8(_)
+            | Integrator::ExpRk4(_) => [0.0; 3],
         }
     }
 
@@ -354,7 +366,10 @@ impl Integrator {
             Integrator::DormandPrince853(m) => m.set_carried_step(h[0]),
             Integrator::Sdirk4(m) => m.set_carried_step(h[0]),
             Integrator::Auto(m) => m.set_memory(h),
-            Integrator::Rk4(_) | Integrator::Rk5(_) | Integrator::Rk8(_) => {}
+            Integrator::Rk4(_)
+            | Integrator::Rk5(_)
+            | Integrator::Rk8(_)
+            | Integrator::ExpRk4(_) => {}
         }
     }
 }
@@ -387,7 +402,7 @@ struct Interval<'a> {
 
 impl RhsJob for Interval<'_> {
     type Output = Result<SolveStats, StepError>;
-    fn run<F: Rhs<{ state::DIM }>>(self, f: &F) -> Self::Output {
+    fn run<F: OscillatorSplit<{ state::DIM }>>(self, f: &F) -> Self::Output {
         self.integrator
             .integrate(f, self.t, self.h, self.y, self.limit)
     }
@@ -716,6 +731,7 @@ impl Simulation {
                     FixedFormula::Rk4 => Integrator::Rk4(Rk4::new(step, n)),
                     FixedFormula::Rk5 => Integrator::Rk5(Rk5::new(step, n)),
                     FixedFormula::Rk8 => Integrator::Rk8(Rk8::new(step, n)),
+                    FixedFormula::ExpRk4 => Integrator::ExpRk4(ExpRk4::new(step, n)),
                 }
             }
         }
@@ -1273,6 +1289,10 @@ mod tests {
             },
             Method::Fixed {
                 formula: FixedFormula::Rk8,
+                step: 0.01,
+            },
+            Method::Fixed {
+                formula: FixedFormula::ExpRk4,
                 step: 0.01,
             },
         ] {

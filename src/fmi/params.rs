@@ -133,6 +133,7 @@ impl Values {
             5 => adaptive(AdaptiveKind::DormandPrince853),
             6 => fixed(FixedFormula::Rk5),
             7 => fixed(FixedFormula::Rk8),
+            8 => fixed(FixedFormula::ExpRk4),
             _ => adaptive(AdaptiveKind::DormandPrince),
         };
         let model = match self.option(vr::MODEL, vr::MODEL_ID) as i64 {

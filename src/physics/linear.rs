@@ -28,6 +28,28 @@ pub struct ModeState {
     pub dissipated: f64,
 }
 
+/// (C(s), S(s)) of the free motion of x'' + 2 sigma x' + w2 x = 0 (see [`Mode`]):
+/// x(s) = C x0 + S (v0 + sigma x0), v(s) = C v0 - S (w2 x0 + sigma v0).
+pub fn free_motion(w2: f64, sigma: f64, s: f64) -> (f64, f64) {
+    let mu2 = w2 - sigma * sigma;
+    let decay = (-sigma * s).exp();
+    let z = mu2 * s * s;
+    let (c, sinc) = if z.abs() < 1e-6 {
+        // Near critical damping: the series of cos and sin(mu s)/mu in mu^2 s^2.
+        (
+            1.0 - z / 2.0 + z * z / 24.0,
+            s * (1.0 - z / 6.0 + z * z / 120.0),
+        )
+    } else if mu2 > 0.0 {
+        let mu = mu2.sqrt();
+        ((mu * s).cos(), (mu * s).sin() / mu)
+    } else {
+        let k = (-mu2).sqrt();
+        ((k * s).cosh(), (k * s).sinh() / k)
+    };
+    (decay * c, decay * sinc)
+}
+
 impl Mode {
     pub fn new(omega: f64, zeta: f64) -> Self {
         Mode {
@@ -54,24 +76,7 @@ impl Mode {
 
     /// (C(s), S(s)) of the free motion.
     fn free(&self, s: f64) -> (f64, f64) {
-        let sigma = self.sigma();
-        let mu2 = self.omega * self.omega - sigma * sigma;
-        let decay = (-sigma * s).exp();
-        let z = mu2 * s * s;
-        let (c, sinc) = if z.abs() < 1e-6 {
-            // Near critical damping: the series of cos and sin(mu s)/mu in mu^2 s^2.
-            (
-                1.0 - z / 2.0 + z * z / 24.0,
-                s * (1.0 - z / 6.0 + z * z / 120.0),
-            )
-        } else if mu2 > 0.0 {
-            let mu = mu2.sqrt();
-            ((mu * s).cos(), (mu * s).sin() / mu)
-        } else {
-            let k = (-mu2).sqrt();
-            ((k * s).cosh(), (k * s).sinh() / k)
-        };
-        (decay * c, decay * sinc)
+        free_motion(self.omega * self.omega, self.sigma(), s)
     }
 
     /// The particular solution x_p(s) = p0 + p1 s + p2 s^2 for a_b = a0 + a1 s + a2 s^2/2.

@@ -2,7 +2,8 @@
 //! MODEL.md section 2): x'' + 2 omega_f zeta x' + Phi(x) = -a_b(t),
 //! Phi(x) = omega_f^2 x [1 + phi |2x/a|^(2 eta - 2)].
 
-use crate::solver::Rhs;
+use super::linear::free_motion;
+use crate::solver::{OscillatorSplit, Rhs};
 
 /// |x|^(2 eta - 2) for one kind of exponent, integer exponents by multiplications rather than
 /// a powf. [`Power`] holds any kind and dispatches at run time; the fixed kinds of [`exponent`]
@@ -237,7 +238,13 @@ impl PowerLaw {
     /// Phi(x) with the exponent `e`, which must be of this law's kind.
     #[inline(always)]
     fn force_with<E: Exponent>(&self, e: E, x: f64) -> f64 {
-        self.omega2 * x + (self.omega2_q * x) * e.abs_pow(x)
+        self.omega2 * x + self.hardening_force_with(e, x)
+    }
+
+    /// Phi(x) - omega_f^2 x, the hardening alone, with the exponent `e`.
+    #[inline(always)]
+    fn hardening_force_with<E: Exponent>(&self, e: E, x: f64) -> f64 {
+        (self.omega2_q * x) * e.abs_pow(x)
     }
 
     /// dPhi/dx = omega_f^2 [1 + (2 eta - 1) phi |xi|^(2eta-2)]: the local stiffness.
@@ -346,6 +353,37 @@ impl NonlinearTld {
         dy[state::DISSIPATED] = self.c * v * v;
     }
 
+    /// The right-hand side less the linear oscillator x'' + c x' + omega_f^2 x (see
+    /// [`OscillatorSplit`]): the input and the hardening.
+    #[inline(always)]
+    fn remainder_with<E: Exponent>(
+        &self,
+        e: E,
+        t: f64,
+        y: &[f64; state::DIM],
+        dy: &mut [f64; state::DIM],
+    ) {
+        let (x, v) = (y[state::X], y[state::V]);
+        let a_b = self.base.at(t);
+        dy[state::X] = 0.0;
+        dy[state::V] = -a_b - self.stiffness.hardening_force_with(e, x);
+        dy[state::WORK_IN] = -a_b * v;
+        dy[state::DISSIPATED] = self.c * v * v;
+    }
+
+    /// (omega_f^2, c) of the linear oscillator in Eq 2.11.
+    fn oscillator(&self) -> (f64, f64) {
+        (self.stiffness.omega2, self.c)
+    }
+
+    /// The exact flow of x'' + c x' + omega_f^2 x = 0 over `tau`.
+    fn propagator(&self, tau: f64) -> [[f64; 2]; 2] {
+        let (w2, c) = self.oscillator();
+        let sigma = 0.5 * c;
+        let (cs, sn) = free_motion(w2, sigma, tau);
+        [[cs + sigma * sn, sn], [-w2 * sn, cs - sigma * sn]]
+    }
+
     /// Run `job` on this model as a right-hand side compiled for its kind of exponent: the
     /// same values as the model itself, without a dispatch per evaluation. Inlined into the
     /// caller: behind a call, the integrator's state would pass through memory both ways.
@@ -372,7 +410,7 @@ impl NonlinearTld {
 /// Work on a right-hand side whose type is chosen at run time ([`NonlinearTld::with_exponent`]).
 pub trait RhsJob {
     type Output;
-    fn run<F: Rhs<{ state::DIM }>>(self, f: &F) -> Self::Output;
+    fn run<F: OscillatorSplit<{ state::DIM }>>(self, f: &F) -> Self::Output;
 }
 
 /// The model with its kind of exponent fixed at compile time.
@@ -393,6 +431,35 @@ impl<E: Exponent> Rhs<{ state::DIM }> for Fixed<'_, E> {
 
     fn stiffness(&self, t: f64, y: &[f64; state::DIM]) -> f64 {
         Rhs::stiffness(self.model, t, y)
+    }
+}
+
+impl<E: Exponent> OscillatorSplit<{ state::DIM }> for Fixed<'_, E> {
+    fn oscillator(&self) -> (f64, f64) {
+        self.model.oscillator()
+    }
+
+    fn propagator(&self, tau: f64) -> [[f64; 2]; 2] {
+        self.model.propagator(tau)
+    }
+
+    #[inline]
+    fn remainder(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
+        self.model.remainder_with(self.exponent, t, y, dy);
+    }
+}
+
+impl OscillatorSplit<{ state::DIM }> for NonlinearTld {
+    fn oscillator(&self) -> (f64, f64) {
+        NonlinearTld::oscillator(self)
+    }
+
+    fn propagator(&self, tau: f64) -> [[f64; 2]; 2] {
+        NonlinearTld::propagator(self, tau)
+    }
+
+    fn remainder(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
+        self.remainder_with(self.stiffness.power, t, y, dy);
     }
 }
 
@@ -535,24 +602,33 @@ mod tests {
 
     #[test]
     fn the_compiled_exponent_gives_the_models_values() {
-        use crate::solver::Rhs;
         struct Evaluate(Vec<[f64; state::DIM]>);
         impl RhsJob for Evaluate {
             type Output = Vec<[f64; state::DIM]>;
-            fn run<F: Rhs<{ state::DIM }>>(self, f: &F) -> Self::Output {
+            fn run<F: OscillatorSplit<{ state::DIM }>>(self, f: &F) -> Self::Output {
                 let mut jac = [[0.0; state::DIM]; state::DIM];
                 let y = [0.03, 0.2, 0.0, 0.0];
                 f.jacobian(0.1, &y, &mut jac);
                 let mut out: Vec<_> = self
                     .0
                     .iter()
-                    .map(|y| {
+                    .flat_map(|y| {
                         let mut dy = [0.0; state::DIM];
                         f.eval(0.1, y, &mut dy);
-                        dy
+                        let mut r = [0.0; state::DIM];
+                        f.remainder(0.1, y, &mut r);
+                        // The split adds up to the whole right-hand side.
+                        let (w2, c) = f.oscillator();
+                        let linear = -w2 * y[state::X] - c * y[state::V];
+                        let whole = linear + r[state::V];
+                        let scale = dy[state::V].abs().max(linear.abs()) + 1.0;
+                        assert!((whole - dy[state::V]).abs() <= 1e-14 * scale, "{y:?}");
+                        assert_eq!(r[state::WORK_IN..], dy[state::WORK_IN..]);
+                        [dy, r]
                     })
                     .collect();
                 out.extend(jac);
+                out.extend(f.propagator(0.37).map(|row| [row[0], row[1], 0.0, 0.0]));
                 out.push([f.stiffness(0.1, &y), 0.0, 0.0, 0.0]);
                 out
             }

@@ -46,51 +46,88 @@ impl<M: Formula> FixedStep<M> {
         t1: f64,
         y: &mut [f64; N],
     ) -> Result<SolveStats, SolveError> {
-        let span = t1 - t0;
-        // One step when the interval fits: the common case, kept free of the step count's
-        // integer-float conversions (u64 to f64 takes several instructions on x86-64) and of
-        // ceil (a libm call on baseline x86-64).
-        if span <= self.max_step && self.max_steps >= 1 {
-            let z = M::step(f, t0, span, y);
-            if !all_finite(&z) {
-                return Err(SolveError::NonFinite { t: t0 });
-            }
-            *y = z;
-            return Ok(SolveStats {
-                accepted: 1,
-                rejected: 0,
-                evaluations: M::EVALS,
-            });
-        }
-        // n = ceil(q) steps, and ceil(q) <= max_steps exactly when q <= max_steps; formed
-        // without libm's ceil (a call on baseline x86-64), counted in i64 (one instruction
-        // to f64, where u64 takes several).
-        let q = span / self.max_step * (1.0 - 1e-12);
-        if q.is_nan() || q > self.max_steps as f64 {
-            return Err(SolveError::TooManySteps {
-                limit: self.max_steps,
-                t: t0,
-            });
-        }
-        let whole = q as i64;
-        let n = if (whole as f64) < q { whole + 1 } else { whole }.max(1);
-        let h = span / n as f64;
-        let mut z = *y;
-        for i in 0..n {
-            let t = t0 + i as f64 * h;
-            z = M::step(f, t, h, &z);
-            if !all_finite(&z) {
-                return Err(SolveError::NonFinite { t });
+        struct Formula<'a, M, F>(&'a F, PhantomData<M>);
+        impl<const N: usize, M: self::Formula, F: Rhs<N>> OneStep<N> for Formula<'_, M, F> {
+            #[inline(always)]
+            fn step(&mut self, t: f64, h: f64, z: &[f64; N]) -> [f64; N] {
+                M::step(self.0, t, h, z)
             }
         }
-        let n = n as u64;
-        *y = z;
-        Ok(SolveStats {
-            accepted: n,
-            rejected: 0,
-            evaluations: M::EVALS * n,
-        })
+        let mut formula = Formula::<M, F>(f, PhantomData);
+        fixed_steps(
+            t0,
+            t1,
+            self.max_step,
+            self.max_steps,
+            M::EVALS,
+            y,
+            &mut formula,
+        )
     }
+}
+
+/// One step of some method, as [`fixed_steps`] repeats it.
+pub(super) trait OneStep<const N: usize> {
+    /// The state after one step of `h` from (t, z).
+    fn step(&mut self, t: f64, h: f64, z: &[f64; N]) -> [f64; N];
+}
+
+/// Advance `y` from `t0` to `t1` by `method`'s steps (`evals` evaluations each) in equal steps
+/// no longer than `max_step`, at most `max_steps` of them. On error `y` is left unchanged.
+#[inline(always)]
+pub(super) fn fixed_steps<const N: usize>(
+    t0: f64,
+    t1: f64,
+    max_step: f64,
+    max_steps: u64,
+    evals: u64,
+    y: &mut [f64; N],
+    method: &mut impl OneStep<N>,
+) -> Result<SolveStats, SolveError> {
+    let span = t1 - t0;
+    // One step when the interval fits: the common case, kept free of the step count's
+    // integer-float conversions (u64 to f64 takes several instructions on x86-64) and of
+    // ceil (a libm call on baseline x86-64).
+    if span <= max_step && max_steps >= 1 {
+        let z = method.step(t0, span, y);
+        if !all_finite(&z) {
+            return Err(SolveError::NonFinite { t: t0 });
+        }
+        *y = z;
+        return Ok(SolveStats {
+            accepted: 1,
+            rejected: 0,
+            evaluations: evals,
+        });
+    }
+    // n = ceil(q) steps, and ceil(q) <= max_steps exactly when q <= max_steps; formed
+    // without libm's ceil (a call on baseline x86-64), counted in i64 (one instruction
+    // to f64, where u64 takes several).
+    let q = span / max_step * (1.0 - 1e-12);
+    if q.is_nan() || q > max_steps as f64 {
+        return Err(SolveError::TooManySteps {
+            limit: max_steps,
+            t: t0,
+        });
+    }
+    let whole = q as i64;
+    let n = if (whole as f64) < q { whole + 1 } else { whole }.max(1);
+    let h = span / n as f64;
+    let mut z = *y;
+    for i in 0..n {
+        let t = t0 + i as f64 * h;
+        z = method.step(t, h, &z);
+        if !all_finite(&z) {
+            return Err(SolveError::NonFinite { t });
+        }
+    }
+    let n = n as u64;
+    *y = z;
+    Ok(SolveStats {
+        accepted: n,
+        rejected: 0,
+        evaluations: evals * n,
+    })
 }
 
 /// The classical fourth-order formula (four evaluations).
