@@ -68,6 +68,10 @@ impl<M: Formula> FixedStep<M> {
 
 /// One step of some method, as [`fixed_steps`] repeats it.
 pub(super) trait OneStep<const N: usize> {
+    /// Called once per interval with the step size all its steps will have.
+    #[inline(always)]
+    fn prepare(&mut self, _h: f64) {}
+
     /// The state after one step of `h` from (t, z).
     fn step(&mut self, t: f64, h: f64, z: &[f64; N]) -> [f64; N];
 }
@@ -89,6 +93,7 @@ pub(super) fn fixed_steps<const N: usize>(
     // integer-float conversions (u64 to f64 takes several instructions on x86-64) and of
     // ceil (a libm call on baseline x86-64).
     if span <= max_step && max_steps >= 1 {
+        method.prepare(span);
         let z = method.step(t0, span, y);
         if !all_finite(&z) {
             return Err(SolveError::NonFinite { t: t0 });
@@ -113,6 +118,7 @@ pub(super) fn fixed_steps<const N: usize>(
     let whole = q as i64;
     let n = if (whole as f64) < q { whole + 1 } else { whole }.max(1);
     let h = span / n as f64;
+    method.prepare(h);
     let mut z = *y;
     for i in 0..n {
         let t = t0 + i as f64 * h;

@@ -25,6 +25,16 @@ struct Flows {
 }
 
 impl Flows {
+    /// The flows of `f`'s linear part for key (h, w2, c). Out of line and cold: inlined, the
+    /// propagator's exp, sin and cos were computed ahead of the cache check on every step
+    /// (the compiler may speculate calls it knows to be pure).
+    #[cold]
+    #[inline(never)]
+    fn of<const N: usize, F: OscillatorSplit<N>>(f: &F, key: [f64; 3]) -> Self {
+        let h = key[0];
+        Flows::new(key, f.propagator(0.5 * h), f.propagator(h))
+    }
+
     fn new(key: [f64; 3], half: [[f64; 2]; 2], full: [[f64; 2]; 2]) -> Self {
         let h = key[0];
         let col = |m: &[[f64; 2]; 2], w: f64| [w * m[0][1], w * m[1][1]];
@@ -95,13 +105,19 @@ impl ExpRk4 {
             cache: &'a mut Flows,
         }
         impl<const N: usize, F: OscillatorSplit<N>> OneStep<N> for Lawson<'_, F> {
+            /// The cache is checked once per interval: all its steps have the same size.
+            #[inline(always)]
+            fn prepare(&mut self, h: f64) {
+                let (w2, c) = self.f.oscillator();
+                let k = &self.cache.key;
+                // (NaN, the empty cache's key, equals nothing.)
+                if !(k[0] == h && k[1] == w2 && k[2] == c) {
+                    *self.cache = Flows::of(self.f, [h, w2, c]);
+                }
+            }
+
             #[inline(always)]
             fn step(&mut self, t: f64, h: f64, z: &[f64; N]) -> [f64; N] {
-                let (w2, c) = self.f.oscillator();
-                let key = [h, w2, c];
-                if self.cache.key != key {
-                    *self.cache = Flows::new(key, self.f.propagator(0.5 * h), self.f.propagator(h));
-                }
                 step(self.f, self.cache, t, h, z)
             }
         }

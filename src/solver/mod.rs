@@ -398,6 +398,48 @@ mod tests {
         }
     }
 
+    #[test]
+    fn exp_rk4_computes_the_flows_once_for_equal_steps() {
+        struct Counted(Duffing, std::cell::Cell<u32>);
+        impl Rhs<3> for Counted {
+            fn eval(&self, t: f64, y: &[f64; 3], dy: &mut [f64; 3]) {
+                self.0.eval(t, y, dy);
+            }
+        }
+        impl OscillatorSplit<3> for Counted {
+            fn oscillator(&self) -> (f64, f64) {
+                self.0.oscillator()
+            }
+            fn propagator(&self, tau: f64) -> [[f64; 2]; 2] {
+                self.1.set(self.1.get() + 1);
+                self.0.propagator(tau)
+            }
+            fn remainder(&self, t: f64, y: &[f64; 3], dy: &mut [f64; 3]) {
+                self.0.remainder(t, y, dy);
+            }
+        }
+        let f = Counted(
+            Duffing {
+                w: 5.6,
+                c: 0.2,
+                eps: 100.0,
+            },
+            std::cell::Cell::new(0),
+        );
+        // One, two and three internal steps per interval, over 100 intervals each integrated
+        // in its own time (as the FMU's steps are).
+        for (n, max_step) in [(1, 0.01), (2, 0.005), (3, 0.004)] {
+            let mut m = ExpRk4::new(max_step, 100);
+            let mut y = [0.1, 0.0, 0.0];
+            f.1.set(0);
+            for _ in 0..100 {
+                let stats = m.integrate(&f, 0.0, 0.01, &mut y).expect("run");
+                assert_eq!(stats.accepted, n);
+            }
+            assert!(f.1.get() <= 2, "{n} steps: {} flows", f.1.get());
+        }
+    }
+
     /// y' = y^2 blows up at t = 1: the integrator must stop with an error, not return garbage.
     #[test]
     fn blow_up_is_reported() {
