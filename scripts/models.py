@@ -24,6 +24,8 @@ MODELS = [
     ("Linear, 3 modes", {"model": 1, "modes": 3}),
     ("Nonlinear (defaults)", {"model": 2}),
     ("Nonlinear, RK4 one substep", {"model": 2, "solver": 2, "solver.fixed_step": None}),
+    ("Nonlinear, ExpRK4 one substep", {"model": 2, "solver": 8, "solver.fixed_step": None}),
+    ("Nonlinear, RK8 one substep", {"model": 2, "solver": 7, "solver.fixed_step": None}),
     ("Auto, threshold = tolerance", {"model": 4}),
     ("Auto, threshold 1e-4", {"model": 4, "auto.threshold": 1e-4}),
     ("Auto, threshold 1e-2", {"model": 4, "auto.threshold": 1e-2}),

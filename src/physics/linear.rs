@@ -31,23 +31,35 @@ pub struct ModeState {
 /// (C(s), S(s)) of the free motion of x'' + 2 sigma x' + w2 x = 0 (see [`Mode`]):
 /// x(s) = C x0 + S (v0 + sigma x0), v(s) = C v0 - S (w2 x0 + sigma v0).
 pub fn free_motion(w2: f64, sigma: f64, s: f64) -> (f64, f64) {
+    let (c_minus_1, sinc) = free_motion_change(w2, sigma, s);
+    (1.0 + c_minus_1, sinc)
+}
+
+/// (C(s) - 1, S(s)) of [`free_motion`], C - 1 to full relative accuracy: for short s it is
+/// small, and a flow applied as y + (P - I) y rounds relative to the change, not to the state
+/// (P rounded once and applied a million times would drift by a million roundings).
+pub fn free_motion_change(w2: f64, sigma: f64, s: f64) -> (f64, f64) {
     let mu2 = w2 - sigma * sigma;
-    let decay = (-sigma * s).exp();
     let z = mu2 * s * s;
-    let (c, sinc) = if z.abs() < 1e-6 {
+    // c = cos(mu s) (cosh when overdamped) and sinc = sin(mu s)/mu, c - 1 by half angles.
+    let (c_minus_1, sinc) = if z.abs() < 1e-6 {
         // Near critical damping: the series of cos and sin(mu s)/mu in mu^2 s^2.
-        (
-            1.0 - z / 2.0 + z * z / 24.0,
-            s * (1.0 - z / 6.0 + z * z / 120.0),
-        )
+        (z * (z / 24.0 - 0.5), s * (1.0 - z / 6.0 + z * z / 120.0))
     } else if mu2 > 0.0 {
         let mu = mu2.sqrt();
-        ((mu * s).cos(), (mu * s).sin() / mu)
+        let half = (0.5 * mu * s).sin();
+        (-2.0 * half * half, (mu * s).sin() / mu)
     } else {
         let k = (-mu2).sqrt();
-        ((k * s).cosh(), (k * s).sinh() / k)
+        let half = (0.5 * k * s).sinh();
+        (2.0 * half * half, (k * s).sinh() / k)
     };
-    (decay * c, decay * sinc)
+    // e^(-sigma s) c - 1 = (e^(-sigma s) - 1) c + (c - 1)
+    let decay_minus_1 = (-sigma * s).exp_m1();
+    (
+        decay_minus_1 * (1.0 + c_minus_1) + c_minus_1,
+        (1.0 + decay_minus_1) * sinc,
+    )
 }
 
 impl Mode {

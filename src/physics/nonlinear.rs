@@ -2,7 +2,7 @@
 //! MODEL.md section 2): x'' + 2 omega_f zeta x' + Phi(x) = -a_b(t),
 //! Phi(x) = omega_f^2 x [1 + phi |2x/a|^(2 eta - 2)].
 
-use super::linear::free_motion;
+use super::linear::free_motion_change;
 use crate::solver::{OscillatorSplit, Rhs};
 
 /// |x|^(2 eta - 2) for one kind of exponent, integer exponents by multiplications rather than
@@ -376,12 +376,12 @@ impl NonlinearTld {
         (self.stiffness.omega2, self.c)
     }
 
-    /// The exact flow of x'' + c x' + omega_f^2 x = 0 over `tau`.
-    fn propagator(&self, tau: f64) -> [[f64; 2]; 2] {
+    /// The exact flow of x'' + c x' + omega_f^2 x = 0 over `tau`, less the identity.
+    fn flow_change(&self, tau: f64) -> [[f64; 2]; 2] {
         let (w2, c) = self.oscillator();
         let sigma = 0.5 * c;
-        let (cs, sn) = free_motion(w2, sigma, tau);
-        [[cs + sigma * sn, sn], [-w2 * sn, cs - sigma * sn]]
+        let (cm1, sn) = free_motion_change(w2, sigma, tau);
+        [[cm1 + sigma * sn, sn], [-w2 * sn, cm1 - sigma * sn]]
     }
 
     /// Run `job` on this model as a right-hand side compiled for its kind of exponent: the
@@ -439,8 +439,8 @@ impl<E: Exponent> OscillatorSplit<{ state::DIM }> for Fixed<'_, E> {
         self.model.oscillator()
     }
 
-    fn propagator(&self, tau: f64) -> [[f64; 2]; 2] {
-        self.model.propagator(tau)
+    fn flow_change(&self, tau: f64) -> [[f64; 2]; 2] {
+        self.model.flow_change(tau)
     }
 
     #[inline]
@@ -454,8 +454,8 @@ impl OscillatorSplit<{ state::DIM }> for NonlinearTld {
         NonlinearTld::oscillator(self)
     }
 
-    fn propagator(&self, tau: f64) -> [[f64; 2]; 2] {
-        NonlinearTld::propagator(self, tau)
+    fn flow_change(&self, tau: f64) -> [[f64; 2]; 2] {
+        NonlinearTld::flow_change(self, tau)
     }
 
     fn remainder(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
@@ -628,7 +628,7 @@ mod tests {
                     })
                     .collect();
                 out.extend(jac);
-                out.extend(f.propagator(0.37).map(|row| [row[0], row[1], 0.0, 0.0]));
+                out.extend(f.flow_change(0.37).map(|row| [row[0], row[1], 0.0, 0.0]));
                 out.push([f.stiffness(0.1, &y), 0.0, 0.0, 0.0]);
                 out
             }

@@ -18,6 +18,7 @@ use super::{OscillatorSplit, SolveError, SolveStats};
 #[derive(Clone, Copy, Debug)]
 struct Flows {
     key: [f64; 3],
+    /// E - I and E2 - I.
     half: [[f64; 2]; 2],
     full: [[f64; 2]; 2],
     /// h/2 E[:, 1], h E[:, 1], h/3 E[:, 1], h/6 E2[:, 1].
@@ -32,12 +33,13 @@ impl Flows {
     #[inline(never)]
     fn of<const N: usize, F: OscillatorSplit<N>>(f: &F, key: [f64; 3]) -> Self {
         let h = key[0];
-        Flows::new(key, f.propagator(0.5 * h), f.propagator(h))
+        Flows::new(key, f.flow_change(0.5 * h), f.flow_change(h))
     }
 
+    /// From the flows' changes E - I and E2 - I.
     fn new(key: [f64; 3], half: [[f64; 2]; 2], full: [[f64; 2]; 2]) -> Self {
         let h = key[0];
-        let col = |m: &[[f64; 2]; 2], w: f64| [w * m[0][1], w * m[1][1]];
+        let col = |d: &[[f64; 2]; 2], w: f64| [w * d[0][1], w * (1.0 + d[1][1])];
         Flows {
             key,
             half,
@@ -144,10 +146,11 @@ fn step<const N: usize, F: OscillatorSplit<N>>(
         dy
     };
     let (e, e2) = (&flows.half, &flows.full);
-    let apply = |m: &[[f64; 2]; 2]| {
+    // E z = z + (E - I) z: rounded relative to the change.
+    let apply = |d: &[[f64; 2]; 2]| {
         [
-            m[0][0] * z[0] + m[0][1] * z[1],
-            m[1][0] * z[0] + m[1][1] * z[1],
+            z[0] + (d[0][0] * z[0] + d[0][1] * z[1]),
+            z[1] + (d[1][0] * z[0] + d[1][1] * z[1]),
         ]
     };
     let (ez, e2z) = (apply(e), apply(e2));
