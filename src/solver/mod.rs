@@ -446,6 +446,27 @@ mod tests {
         }
     }
 
+    /// Damping that changes from one interval to the next (a tracked amplitude) and steps of
+    /// another size: the cached flows follow, the same values as a fresh integrator's.
+    #[test]
+    fn exp_rk4_flows_follow_the_damping_and_the_step() {
+        let (mut kept, mut y_kept, mut y_fresh) =
+            (ExpRk4::new(0.004, 100), [0.1, 0.0, 0.0], [0.1, 0.0, 0.0]);
+        for k in 0..50 {
+            let f = Duffing {
+                w: 5.6,
+                c: 0.1 + 0.01 * (k % 7) as f64,
+                eps: 100.0,
+            };
+            let h = if k % 5 == 0 { 0.013 } else { 0.01 };
+            kept.integrate(&f, 0.0, h, &mut y_kept).expect("kept");
+            ExpRk4::new(0.004, 100)
+                .integrate(&f, 0.0, h, &mut y_fresh)
+                .expect("fresh");
+            assert_eq!(y_kept, y_fresh, "interval {k}");
+        }
+    }
+
     /// y' = y^2 blows up at t = 1: the integrator must stop with an error, not return garbage.
     #[test]
     fn blow_up_is_reported() {
