@@ -31,35 +31,69 @@ pub struct ModeState {
 /// (C(s), S(s)) of the free motion of x'' + 2 sigma x' + w2 x = 0 (see [`Mode`]):
 /// x(s) = C x0 + S (v0 + sigma x0), v(s) = C v0 - S (w2 x0 + sigma v0).
 pub fn free_motion(w2: f64, sigma: f64, s: f64) -> (f64, f64) {
-    let (c_minus_1, sinc) = free_motion_change(w2, sigma, s);
-    (1.0 + c_minus_1, sinc)
+    let m = FreeMotion::new(w2, sigma, s);
+    (m.c, m.s)
 }
 
-/// (C(s) - 1, S(s)) of [`free_motion`], C - 1 to full relative accuracy: for short s it is
+/// (C(s) - 1, S(s)) of [`free_motion`], C - 1 formed without forming C: for short s it is
 /// small, and a flow applied as y + (P - I) y rounds relative to the change, not to the state
 /// (P rounded once and applied a million times would drift by a million roundings).
 pub fn free_motion_change(w2: f64, sigma: f64, s: f64) -> (f64, f64) {
-    let mu2 = w2 - sigma * sigma;
-    let z = mu2 * s * s;
-    // c = cos(mu s) (cosh when overdamped) and sinc = sin(mu s)/mu, c - 1 by half angles.
-    let (c_minus_1, sinc) = if z.abs() < 1e-6 {
-        // Near critical damping: the series of cos and sin(mu s)/mu in mu^2 s^2.
-        (z * (z / 24.0 - 0.5), s * (1.0 - z / 6.0 + z * z / 120.0))
-    } else if mu2 > 0.0 {
-        let mu = mu2.sqrt();
-        let half = (0.5 * mu * s).sin();
-        (-2.0 * half * half, (mu * s).sin() / mu)
-    } else {
-        let k = (-mu2).sqrt();
-        let half = (0.5 * k * s).sinh();
-        (2.0 * half * half, (k * s).sinh() / k)
-    };
-    // e^(-sigma s) c - 1 = (e^(-sigma s) - 1) c + (c - 1)
-    let decay_minus_1 = (-sigma * s).exp_m1();
-    (
-        decay_minus_1 * (1.0 + c_minus_1) + c_minus_1,
-        (1.0 + decay_minus_1) * sinc,
-    )
+    let m = FreeMotion::new(w2, sigma, s);
+    (m.c_minus_1, m.s)
+}
+
+/// C, C - 1 and S of the free motion, each from its own formula.
+struct FreeMotion {
+    c: f64,
+    c_minus_1: f64,
+    s: f64,
+}
+
+impl FreeMotion {
+    fn new(w2: f64, sigma: f64, s: f64) -> Self {
+        let mu2 = w2 - sigma * sigma;
+        let z = mu2 * s * s;
+        if mu2 < 0.0 && z.abs() >= 1e-6 {
+            // Overdamped: two real decay rates, a = sigma - k (as w2 / (sigma + k), no
+            // cancellation) and b = sigma + k; C = (e^(-a s) + e^(-b s))/2. Written with the
+            // rates rather than e^(-sigma s) cosh(k s), which overflows against underflow.
+            let k = (-mu2).sqrt();
+            let (a, b) = (w2 / (sigma + k), sigma + k);
+            let (ea, eb) = ((-a * s).exp(), (-b * s).exp());
+            let sinc = if k * s < 1.0 {
+                // sinh(k s)/k: no cancellation between two nearly equal exponentials
+                (-sigma * s).exp() * (k * s).sinh() / k
+            } else {
+                (ea - eb) / (2.0 * k)
+            };
+            return FreeMotion {
+                c: 0.5 * (ea + eb),
+                c_minus_1: 0.5 * ((-a * s).exp_m1() + (-b * s).exp_m1()),
+                s: sinc,
+            };
+        }
+        // c = cos(mu s), its change c - 1 by the half angle, sinc = sin(mu s)/mu; near
+        // critical damping their series in mu^2 s^2 (either sign of mu^2).
+        let (c, c_minus_1, sinc) = if z.abs() < 1e-6 {
+            (
+                1.0 - z / 2.0 + z * z / 24.0,
+                z * (z / 24.0 - 0.5),
+                s * (1.0 - z / 6.0 + z * z / 120.0),
+            )
+        } else {
+            let mu = mu2.sqrt();
+            let half = (0.5 * mu * s).sin();
+            ((mu * s).cos(), -2.0 * half * half, (mu * s).sin() / mu)
+        };
+        let decay = (-sigma * s).exp();
+        FreeMotion {
+            c: decay * c,
+            // e^(-sigma s) c - 1 = (e^(-sigma s) - 1) c + (c - 1)
+            c_minus_1: (-sigma * s).exp_m1() * c + c_minus_1,
+            s: decay * sinc,
+        }
+    }
 }
 
 impl Mode {
@@ -206,6 +240,37 @@ mod tests {
                 "zeta {zeta}: {} {}",
                 s.x - x,
                 s.v - v
+            );
+        }
+    }
+
+    /// Heavily overdamped free decay over long steps (sigma s up to 420, where e^(-sigma s)
+    /// cosh(k s) would be 0 times infinity): against the closed form's slow mode
+    /// x = x0 (b e^(-a t) - a e^(-b t)) / (b - a) from rest, relative to the true (small) x.
+    #[test]
+    fn overdamped_free_decay_over_long_steps() {
+        let (omega, zeta) = (5.6f64, 5.0);
+        let sigma = zeta * omega;
+        let k = (sigma * sigma - omega * omega).sqrt();
+        let (a, b) = (omega * omega / (sigma + k), sigma + k);
+        for h in [1.0, 3.0, 15.0] {
+            let mut m = Mode::new(omega, zeta);
+            let mut s = ModeState {
+                x: 0.01,
+                ..Default::default()
+            };
+            m.advance(&mut s, h, &held(0.0));
+            let exact = 0.01 * (b * (-a * h).exp() - a * (-b * h).exp()) / (b - a);
+            let exact_v = 0.01 * a * b * ((-b * h).exp() - (-a * h).exp()) / (b - a);
+            assert!(
+                (s.x / exact - 1.0).abs() < 1e-12,
+                "h {h}: {} vs {exact}",
+                s.x
+            );
+            assert!(
+                (s.v / exact_v - 1.0).abs() < 1e-12,
+                "h {h}: {} vs {exact_v}",
+                s.v
             );
         }
     }

@@ -349,6 +349,12 @@ impl NonlinearTld {
         // The restoring force last: it ends the longest chain (x to Phi), so one subtraction
         // follows it, not two.
         dy[state::V] = (-a_b - self.c * v) - self.stiffness.force_with(e, x);
+        self.quadratures(a_b, v, dy);
+    }
+
+    /// The energy integrands: work input -a_b x' and dissipation c x'^2.
+    #[inline(always)]
+    fn quadratures(&self, a_b: f64, v: f64, dy: &mut [f64; state::DIM]) {
         dy[state::WORK_IN] = -a_b * v;
         dy[state::DISSIPATED] = self.c * v * v;
     }
@@ -367,8 +373,7 @@ impl NonlinearTld {
         let a_b = self.base.at(t);
         dy[state::X] = 0.0;
         dy[state::V] = -a_b - self.stiffness.hardening_force_with(e, x);
-        dy[state::WORK_IN] = -a_b * v;
-        dy[state::DISSIPATED] = self.c * v * v;
+        self.quadratures(a_b, v, dy);
     }
 
     /// (omega_f^2, c) of the linear oscillator in Eq 2.11.
@@ -653,6 +658,46 @@ mod tests {
             let compiled = m.with_exponent(Evaluate(states.clone()));
             let direct = Evaluate(states).run(&m);
             assert_eq!(compiled, direct, "eta {eta} phi {phi}");
+        }
+    }
+
+    /// The linear part's flow: its derivative at 0 is the linear part (entries of P - I over a
+    /// short tau), and flows compose, P(a + b) = P(a) P(b); under-, critically and overdamped.
+    #[test]
+    fn the_linear_flow_is_the_oscillators() {
+        for c in [0.0, 0.3, 2.0 * 5.6, 30.0] {
+            let m = NonlinearTld {
+                stiffness: PowerLaw::new(5.6, 1.0, 2.0, 0.25),
+                c,
+                base: BaseAcceleration::held(0.0),
+            };
+            let (w2, _) = m.oscillator();
+            let tau = 1e-7;
+            let d = m.flow_change(tau);
+            let linear = [[0.0, 1.0], [-w2, -c]];
+            for i in 0..2 {
+                for j in 0..2 {
+                    let rate = d[i][j] / tau;
+                    assert!(
+                        (rate - linear[i][j]).abs() < 1e-5 * (1.0 + w2),
+                        "c {c} [{i}][{j}]: {rate}"
+                    );
+                }
+            }
+            let p = |t: f64| {
+                let d = m.flow_change(t);
+                [[1.0 + d[0][0], d[0][1]], [d[1][0], 1.0 + d[1][1]]]
+            };
+            let (pa, pb, pab) = (p(0.13), p(0.29), p(0.42));
+            for i in 0..2 {
+                for j in 0..2 {
+                    let composed = pa[i][0] * pb[0][j] + pa[i][1] * pb[1][j];
+                    assert!(
+                        (composed - pab[i][j]).abs() < 1e-14 * (1.0 + w2),
+                        "c {c} [{i}][{j}]"
+                    );
+                }
+            }
         }
     }
 

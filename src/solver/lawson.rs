@@ -1,8 +1,8 @@
 //! Exponential (Lawson) fourth-order Runge-Kutta with a fixed internal step, for a right-hand
 //! side split into a damped linear oscillator and a remainder ([`OscillatorSplit`]): classical
-//! RK4 on the remainder in the frame that moves with the oscillator's exact flow. A purely
-//! linear oscillator is integrated exactly whatever the step, and the error of a weakly
-//! nonlinear one scales with the remainder, not with the oscillation.
+//! RK4 on the remainder in the frame that moves with the oscillator's exact flow. The free
+//! motion of a linear oscillator is integrated exactly whatever the step, and the error of a
+//! weakly nonlinear one scales with the remainder, not with the oscillation.
 //!
 //! With E = exp(L h/2) and E2 = exp(L h) the flows of the linear part L, and k_i the remainder:
 //!   k1 = r(t, y),               k2 = r(t + h/2, E (y + h/2 k1)),

@@ -126,16 +126,20 @@ def test_fixed_step_solvers(slave_factory, solver, order, dt, fixed_step):
     n = int(round(20.0 / dt))
     bx, bv, ba = R.harmonic_base(1.05 * p.omega_f, 0.005, dt * np.arange(n))
     ref = R.simulate_held(p, dt, ba, substeps=int(round(dt / 1e-3)))
-    errs = []
+    errs, energy_errs = [], []
     for h in (fixed_step, fixed_step / 2):
         s = slave_factory(quiet=True)
         s.initialize({**p.fmu_parameters(), "solver": solver, "solver.fixed_step": h})
-        out = s.run(dt, {"base.x": bx, "base.v": bv, "base.a": ba}, ["slosh.x"])
+        out = s.run(dt, {"base.x": bx, "base.v": bv, "base.a": ba}, ["slosh.x", "energy.dissipated"])
         errs.append(R.rel_err(out["slosh.x"], ref.x))
+        energy_errs.append(R.rel_err(out["energy.dissipated"], ref.energy_dissipated))
     measured = np.log2(errs[0] / errs[1])
-    print(f"solver {solver}: errors {errs[0]:.2e}, {errs[1]:.2e}, order {measured:.2f}")
+    print(f"solver {solver}: errors {errs[0]:.2e}, {errs[1]:.2e}, order {measured:.2f}; "
+          f"energy.dissipated {energy_errs[0]:.2e}, {energy_errs[1]:.2e}")
     assert errs[0] < 1e-6 and errs[1] > 1e3 * 1e-15
     assert abs(measured - order) < 0.5
+    # the energy integrals ride along at the state's accuracy
+    assert max(energy_errs) < 10 * errs[0]
 
 
 @pytest.mark.parametrize("amplitude,gain", [(5e-4, 100.0), (0.005, 5.0)], ids=["wind", "design"])
