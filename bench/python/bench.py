@@ -385,9 +385,9 @@ class FmuInfo:
             fixed = "fixed" in desc.lower() and "tolerance" not in desc.lower()
             sel = self.token("solver", val)
             if fixed:
-                m = re.fullmatch(r"RK(\d+)", name)
+                m = re.search(r"RK(\d+)$", name)  # RK4, RK5, RK8, ExpRK4
                 order = int(m.group(1)) if m else 4
-                for n in rk4_substeps(dt, quick, h_min=round_off_step(order, omega_f)):
+                for n in substep_counts(dt, quick, h_min=round_off_step(order, omega_f)):
                     out.append((name, f"n={n}", [sel, self.token("solver.fixed_step", dt / n)]))
             else:
                 tols = TOLS if not quick else [1e-6, 1e-10]
@@ -407,7 +407,7 @@ def round_off_step(order, omega_f):
     return max(H_MIN_RK4, 1e-14 ** (1.0 / order) / omega_f)
 
 
-def rk4_substeps(dt, quick, cap=N_MAX_RK4, h_min=H_MIN_RK4):
+def substep_counts(dt, quick, cap=N_MAX_RK4, h_min=H_MIN_RK4):
     """n = 1, 2, 4, ... while dt/n >= h_min (n = 1 always)."""
     ns, n = [], 1
     while (n == 1 or dt / n >= h_min * (1 - 1e-9)) and n <= (4 if quick else cap):
@@ -452,12 +452,12 @@ def run_native(fi: FmuInfo, sc: Scene, dt, a, refs, quick, tmp: Path):
         rid = f"rust_DP45_{tol:g}"
         meta[rid] = dict(impl="Rust baseline", method="DP45", setting=f"tol={tol:g}")
         lines.append(f"run {rid} dp45 rtol={tol!r}")
-    for ns in rk4_substeps(dt, quick):
+    for ns in substep_counts(dt, quick):
         rid = f"rust_RK4_{ns}"
         meta[rid] = dict(impl="Rust baseline", method="RK4", setting=f"n={ns}")
         lines.append(f"run {rid} rk4 sub={ns}")
     # diagnostic (not a baseline): the most accurate RK4 integrating over (t + dt) - t
-    ns = rk4_substeps(dt, quick)[-1]
+    ns = substep_counts(dt, quick)[-1]
     rid = f"rust_RK4abs_{ns}"
     meta[rid] = dict(impl="Rust diagnostic", method="RK4 over (t+dt)-t", setting=f"n={ns}")
     lines.append(f"run {rid} rk4 sub={ns} span=abs")
@@ -635,7 +635,7 @@ def run_python(fi, sc, dt, a, refs, quick, tld_slave, py_slave):
             _warm["py"] = True
         py_params = dict(tank_length=p.a, tank_breadth=p.b, tank_depth=p.h, density=p.rho,
                          g=p.g, eta=p.eta, phi=p.phi, zeta=p.zeta_fixed)
-        for ns in rk4_substeps(dt, quick, cap=32):
+        for ns in substep_counts(dt, quick, cap=32):
             def go(ns=ns):
                 s = py_slave()
                 try:
