@@ -6,7 +6,9 @@ use crate::physics::geometry::Tank;
 use crate::physics::laws::nsd_kappa;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 use crate::physics::linear::{Mode, ModeState};
-use crate::physics::nonlinear::{BaseAcceleration, NonlinearTld, PowerLaw, RhsJob, state};
+use crate::physics::nonlinear::{
+    BaseAcceleration, CompiledTld, NonlinearTld, PowerLaw, RhsJob, state,
+};
 use crate::physics::slamming::{SlamState, Slamming};
 use crate::solver::{
     Auto, Dop853, Dopri5, ExpRk4, OscillatorSplit, Rk4, Rk5, Rk8, Sdirk4, SolveError, SolveStats,
@@ -401,10 +403,13 @@ struct Interval<'a> {
 }
 
 impl RhsJob for Interval<'_> {
-    type Output = Result<SolveStats, StepError>;
-    fn run<F: OscillatorSplit<{ state::DIM }>>(self, f: &F) -> Self::Output {
-        self.integrator
-            .integrate(f, self.t, self.h, self.y, self.limit)
+    /// The step's statistics and the force per unit sloshing mass at its end.
+    type Output = Result<(SolveStats, f64), StepError>;
+    fn run<F: CompiledTld>(self, f: &F) -> Self::Output {
+        let stats = self
+            .integrator
+            .integrate(f, self.t, self.h, self.y, self.limit)?;
+        Ok((stats, f.tank_force(self.y[state::X], self.y[state::V])))
     }
 }
 
@@ -570,6 +575,9 @@ pub struct Simulation {
     /// Damping ratio in use.
     zeta: f64,
     last_mean_force: Option<f64>,
+    /// Force of the liquid on the tanks at the current state [N] ([`Simulation::tank_force`]),
+    /// kept with the state: a master reads it after every step, where it is a load.
+    force: f64,
 }
 
 impl Simulation {
@@ -682,7 +690,7 @@ impl Simulation {
                 (Dynamics::Linear { modes }, energy)
             }
         };
-        let sim = Simulation {
+        let mut sim = Simulation {
             config,
             derived,
             dynamics,
@@ -691,7 +699,9 @@ impl Simulation {
             amplitude,
             zeta,
             last_mean_force: None,
+            force: 0.0,
         };
+        sim.force = sim.tank_force();
         Ok((sim, warnings))
     }
 
@@ -771,7 +781,7 @@ impl Simulation {
         // The impulse of each mode's force on the tank over the step follows from its velocity
         // change, v' = -a_b - f: integral f = -dv - integral a_b (for a Runge-Kutta step too:
         // h sum b_i f_i = -dv - h sum b_i a_b(t_i), the input's quadrature being exact).
-        let (stats, impulse) = match &mut self.dynamics {
+        let (stats, impulse, force) = match &mut self.dynamics {
             Dynamics::Nonlinear {
                 model,
                 integrator,
@@ -794,13 +804,14 @@ impl Simulation {
                     }
                     None => None,
                 };
-                let stats = match linear {
+                let (stats, force) = match linear {
                     Some(next) => {
                         *y = next;
-                        SolveStats {
+                        let stats = SolveStats {
                             accepted: 1,
                             ..SolveStats::default()
-                        }
+                        };
+                        (stats, model.tank_force(y[state::X], y[state::V]))
                     }
                     None => match model.with_exponent(Interval {
                         integrator,
@@ -809,20 +820,26 @@ impl Simulation {
                         y,
                         limit,
                     }) {
-                        Ok(stats) => stats,
+                        Ok(done) => done,
                         Err(e) => {
                             (model.c, model.base) = previous;
                             return Err(e);
                         }
                     },
                 };
-                (stats, mass * (-(y[state::V] - v0) - base.integral(h)))
+                let impulse = mass * (-(y[state::V] - v0) - base.integral(h));
+                (stats, impulse, Some(mass * force))
             }
-            Dynamics::Linear { modes } => step_linear(modes, zeta, h, &base, limit)?,
+            Dynamics::Linear { modes } => {
+                let (stats, impulse) = step_linear(modes, zeta, h, &base, limit)?;
+                (stats, impulse, None)
+            }
             Dynamics::Slamming { mode, impact } => {
-                step_slamming(mode, impact, zeta, h, &base, limit)?
+                let (stats, impulse) = step_slamming(mode, impact, zeta, h, &base, limit)?;
+                (stats, impulse, None)
             }
         };
+        self.force = force.unwrap_or_else(|| self.tank_force());
         self.finish_step(zeta, tracker, impulse * inv_h, stats)
     }
 
@@ -978,6 +995,7 @@ impl Simulation {
             Dynamics::Linear { modes } => modes.iter_mut().for_each(|m| m.0.zeta = zeta),
             Dynamics::Slamming { mode, .. } => mode.0.zeta = zeta,
         }
+        sim.force = sim.tank_force();
         Ok(sim)
     }
 
@@ -998,15 +1016,23 @@ impl Simulation {
         }
     }
 
-    /// The output `which` now. The three a master reads after every step are dispatched
-    /// first, by direct branches the caller can inline; the others by a table.
+    /// The output `which` now.
     #[inline]
     pub fn output(&self, which: Output, inputs: &Inputs) -> f64 {
+        self.per_step_output(which)
+            .unwrap_or_else(|| self.other_output(which, inputs))
+    }
+
+    /// The output `which` if it is one of the three a master reads after every step: loads,
+    /// with no call and nothing that can panic (the FMI layer's per-step read then needs no
+    /// stack frame). None for the others.
+    #[inline(always)]
+    pub fn per_step_output(&self, which: Output) -> Option<f64> {
         match which {
-            Output::X => self.x(),
-            Output::V => self.v(),
-            Output::Force => self.force(),
-            _ => self.other_output(which, inputs),
+            Output::X => Some(self.x()),
+            Output::V => Some(self.v()),
+            Output::Force => Some(self.force),
+            _ => None,
         }
     }
 
@@ -1019,23 +1045,31 @@ impl Simulation {
         }
     }
 
+    /// The (fundamental) sloshing mass's state: its relative displacement and velocity.
+    #[inline(always)]
+    fn fundamental(&self) -> (f64, f64) {
+        match &self.dynamics {
+            Dynamics::Nonlinear { y, .. } => (y[state::X], y[state::V]),
+            Dynamics::Slamming { mode, .. } => (mode.2.x, mode.2.v),
+            // There is always a first mode.
+            Dynamics::Linear { modes } => modes.first().map_or((0.0, 0.0), |m| (m.2.x, m.2.v)),
+        }
+    }
+
     /// Relative displacement of the (fundamental) sloshing mass.
-    #[inline]
+    #[inline(always)]
     fn x(&self) -> f64 {
-        self.nonlinear()
-            .map_or_else(|| self.linear_modes()[0].2.x, |(_, y)| y[state::X])
+        self.fundamental().0
     }
 
     /// Relative velocity of the (fundamental) sloshing mass.
-    #[inline]
+    #[inline(always)]
     fn v(&self) -> f64 {
-        self.nonlinear()
-            .map_or_else(|| self.linear_modes()[0].2.v, |(_, y)| y[state::V])
+        self.fundamental().1
     }
 
-    /// Force of the liquid on the tanks.
-    #[inline]
-    fn force(&self) -> f64 {
+    /// Force of the liquid on the tanks, from the state (kept in [`Simulation::force`]).
+    fn tank_force(&self) -> f64 {
         match self.nonlinear() {
             Some((model, y)) => {
                 self.derived.mass_slosh * model.tank_force(y[state::X], y[state::V])
@@ -1066,11 +1100,11 @@ impl Simulation {
         match which {
             Output::X => self.x(),
             Output::V => self.v(),
-            Output::Force => self.force(),
-            Output::ForceMean => self.last_mean_force.unwrap_or_else(|| self.force()),
+            Output::Force => self.force,
+            Output::ForceMean => self.last_mean_force.unwrap_or(self.force),
             // The impact mass resting on a wall moves with the tank, like the inactive liquid.
             Output::BaseShear => {
-                self.force()
+                self.force
                     - self.derived.mass_inactive * inputs.a
                     - over_impact(&|s| if s.contact != 0 { inputs.a } else { 0.0 })
             }
@@ -1316,6 +1350,92 @@ mod tests {
             );
             assert_eq!(sim, before, "{method:?}");
             sim.step(0.013, 0.01, &push(0.3)).expect("usable after");
+        }
+    }
+
+    /// The force kept with the state is the state's force, bit for bit: from the start, after
+    /// every step (the damping moving with a tracked amplitude), a refused step and a restore,
+    /// for every model, kind of exponent and path through the step.
+    #[test]
+    fn the_force_kept_with_the_state_is_the_states_force() {
+        let fixed = |formula| Method::Fixed {
+            formula,
+            step: 0.004,
+        };
+        let nonlinear = |model, eta, method| (model, eta, method);
+        let dp45 = config().method;
+        let mut cases = vec![];
+        for eta in [1.0, 1.5, 2.0, 2.5, 3.0, 5.0] {
+            cases.push(nonlinear(ModelKind::Nonlinear, eta, dp45));
+        }
+        for method in [fixed(FixedFormula::Rk4), fixed(FixedFormula::ExpRk4)] {
+            cases.push(nonlinear(ModelKind::Nonlinear, 2.0, method));
+        }
+        // Mostly below the threshold: the exact linear step.
+        let auto = ModelKind::NonlinearAuto { threshold: 1e-3 };
+        cases.push(nonlinear(auto, 2.0, dp45));
+        cases.push(nonlinear(ModelKind::Linear { modes: 3 }, 2.0, dp45));
+        let slamming = ModelKind::SloshingSlamming(SlammingParams {
+            omega: 0.9,
+            restitution: 0.4,
+            clearance: 0.1,
+            mass_ratio: 0.01,
+        });
+        cases.push(nonlinear(slamming, 2.0, dp45));
+        for (model, eta, method) in cases {
+            let cfg = Config {
+                model,
+                eta,
+                method,
+                x0: 0.02,
+                amplitude: AmplitudeSource::Tracked {
+                    tau: 0.0,
+                    prior: 0.005,
+                },
+                ..config()
+            };
+            let same = |sim: &Simulation, when: &str| {
+                let kept = sim.output(Output::Force, &Inputs::default());
+                assert_eq!(
+                    kept.to_bits(),
+                    sim.tank_force().to_bits(),
+                    "{model:?} eta {eta} {method:?}, {when}: {kept} vs {}",
+                    sim.tank_force()
+                );
+                assert_ne!(kept, 0.0, "{model:?}: a state with a force");
+            };
+            let (mut sim, _) = Simulation::new(cfg).expect("config");
+            same(&sim, "start");
+            let mut zetas = vec![];
+            for k in 0..300 {
+                let t = f64::from(k) * 0.01;
+                let inputs = Inputs {
+                    a: 0.3 * (5.6 * t).sin(),
+                    v: -0.3 / 5.6 * (5.6 * t).cos(),
+                    ..Inputs::default()
+                };
+                sim.step(t, 0.01, &inputs).expect("step");
+                same(&sim, &format!("step {k}"));
+                zetas.push(sim.zeta);
+            }
+            assert_ne!(zetas[299], zetas[298], "{model:?}: the damping moves");
+            let refused = sim.step(
+                3.0,
+                0.1,
+                &Inputs {
+                    a: -1e300,
+                    ..Inputs::default()
+                },
+            );
+            assert!(
+                refused.is_err(),
+                "{model:?} eta {eta} {method:?}: {refused:?} x {}",
+                sim.x()
+            );
+            same(&sim, "a refused step");
+            let restored = Simulation::restore(cfg, &sim.snapshot()).expect("restore");
+            same(&restored, "restored");
+            assert_eq!(restored.force.to_bits(), sim.force.to_bits());
         }
     }
 

@@ -447,7 +447,8 @@ impl Instance {
     /// answers when it succeeds, without building argument slices or refusals. None (nothing
     /// written that matters: the general path then writes every value or refuses) when a
     /// pointer is null or misaligned, calls are logged, the state does not allow gets, there is
-    /// no simulation yet, or a variable is anything but a Real output or stored Real.
+    /// no simulation yet, or a variable is anything but a stored Real or an output of
+    /// [`Simulation::per_step_output`].
     ///
     /// # Safety
     /// `vr` and `value`, when not null, must point to `nvr` elements each.
@@ -472,12 +473,11 @@ impl Instance {
             return None;
         }
         let sim = self.sim.as_ref()?;
-        let inputs = self.values.inputs(self.a_derivatives);
         for k in 0..nvr {
             // SAFETY: k < nvr, per the contract.
             let r = unsafe { *vr.add(k) };
             let v = match source_of(r, VarType::Real) {
-                Source::Output(which) => sim.output(which, &inputs),
+                Source::Output(which) => sim.per_step_output(which)?,
                 Source::Stored(index) => self.values.at(index),
                 _ => return None,
             };
@@ -508,11 +508,10 @@ impl Instance {
         }
         // SAFETY: one element each, per the contract.
         let (r, v) = unsafe { (*vr, *value) };
-        // The per-step input by a table lookup; any other variable by the full check.
-        let index = match free_real_input(r) {
-            Some(index) if finite(v) => index,
-            _ => self.check_set(r, v, VarType::Real, "fmi2SetReal").ok()?,
-        };
+        // The per-step input by a table lookup; any other variable (and a value that is not
+        // finite) by the general path's full check. Nothing here calls out, so the host's
+        // per-step call costs no saved registers.
+        let index = free_real_input(r).filter(|_| finite(v))?;
         self.put(r, index, v);
         Some(Status::Ok)
     }

@@ -415,7 +415,27 @@ impl NonlinearTld {
 /// Work on a right-hand side whose type is chosen at run time ([`NonlinearTld::with_exponent`]).
 pub trait RhsJob {
     type Output;
-    fn run<F: OscillatorSplit<{ state::DIM }>>(self, f: &F) -> Self::Output;
+    fn run<F: CompiledTld>(self, f: &F) -> Self::Output;
+}
+
+/// The model compiled for its kind of exponent, as [`RhsJob`]s get it.
+pub trait CompiledTld: OscillatorSplit<{ state::DIM }> {
+    /// [`NonlinearTld::tank_force`], with the exponent's kind known.
+    fn tank_force(&self, x: f64, v: f64) -> f64;
+}
+
+impl<E: Exponent> CompiledTld for Fixed<'_, E> {
+    #[inline(always)]
+    fn tank_force(&self, x: f64, v: f64) -> f64 {
+        self.model.c * v + self.model.stiffness.force_with(self.exponent, x)
+    }
+}
+
+/// The model itself, its exponent's kind dispatched at every use.
+impl CompiledTld for NonlinearTld {
+    fn tank_force(&self, x: f64, v: f64) -> f64 {
+        NonlinearTld::tank_force(self, x, v)
+    }
 }
 
 /// The model with its kind of exponent fixed at compile time.
@@ -610,7 +630,7 @@ mod tests {
         struct Evaluate(Vec<[f64; state::DIM]>);
         impl RhsJob for Evaluate {
             type Output = Vec<[f64; state::DIM]>;
-            fn run<F: OscillatorSplit<{ state::DIM }>>(self, f: &F) -> Self::Output {
+            fn run<F: CompiledTld>(self, f: &F) -> Self::Output {
                 let mut jac = [[0.0; state::DIM]; state::DIM];
                 let y = [0.03, 0.2, 0.0, 0.0];
                 f.jacobian(0.1, &y, &mut jac);
@@ -629,7 +649,8 @@ mod tests {
                         let scale = dy[state::V].abs().max(linear.abs()) + 1.0;
                         assert!((whole - dy[state::V]).abs() <= 1e-14 * scale, "{y:?}");
                         assert_eq!(r[state::WORK_IN..], dy[state::WORK_IN..]);
-                        [dy, r]
+                        let force = f.tank_force(y[state::X], y[state::V]);
+                        [dy, r, [force, 0.0, 0.0, 0.0]]
                     })
                     .collect();
                 out.extend(jac);
