@@ -431,36 +431,42 @@ fn advance_mode(
 
 /// model = Auto: the nonlinear state advanced by the exact linear solution, if the hardening
 /// phi |2x/a|^(2eta-2) stays below `threshold` over the whole step (Eq 2.11 is then linear to
-/// that tolerance and its exact solution is cheaper than any integrator); None if it may not.
+/// that tolerance and its exact solution is cheaper than any integrator); None if it may not;
+/// a runaway error (nothing changed) if the displacement leaves `limit`.
 /// The bound on |x| over the step: the free amplitude now, plus twice the static deflection
 /// and the growth of one step under the largest base acceleration of the step.
 #[inline(never)]
 fn linear_step(
     model: &NonlinearTld,
-    threshold: f64,
-    mode: &mut Mode,
+    (threshold, mode): &mut (f64, Mode),
     zeta: f64,
     y: &[f64; state::DIM],
     h: f64,
     base: &BaseAcceleration,
-) -> Option<[f64; state::DIM]> {
+    limit: f64,
+) -> Option<Result<[f64; state::DIM], StepError>> {
     let omega_f = mode.omega;
     let (x, v) = (y[state::X], y[state::V]);
     let a_max = base.a[0].abs() + h * (base.a[1].abs() + 0.5 * h * base.a[2].abs());
     let bound =
         (x * x + (v / omega_f).powi(2)).sqrt() + a_max * (2.0 / (omega_f * omega_f) + h / omega_f);
-    if model.stiffness.hardening(bound) >= threshold {
+    if model.stiffness.hardening(bound) >= *threshold {
         return None;
     }
-    mode.zeta = zeta;
+    let mut next_mode = *mode;
+    next_mode.zeta = zeta;
     let mut s = ModeState {
         x,
         v,
         work_in: y[state::WORK_IN],
         dissipated: y[state::DISSIPATED],
     };
-    mode.advance(&mut s, h, base);
-    Some([s.x, s.v, s.work_in, s.dissipated])
+    next_mode.advance(&mut s, h, base);
+    // Without hardening (phi = 0) nothing else bounds the motion: checked as every step is.
+    Some(check_runaway(s.x, limit).map(|()| {
+        *mode = next_mode;
+        [s.x, s.v, s.work_in, s.dissipated]
+    }))
 }
 
 /// model = Linear: every mode advanced exactly; the statistics of the step and the impulse of
@@ -798,34 +804,32 @@ impl Simulation {
                 let v0 = y[state::V];
                 // model = Auto: the exact linear solution while the hardening is below the
                 // threshold; otherwise the integrator.
-                let linear = match linear_below.as_mut() {
-                    Some((threshold, mode)) => {
-                        linear_step(model, *threshold, mode, zeta, y, h, &base)
-                    }
-                    None => None,
-                };
-                let (stats, force) = match linear {
-                    Some(next) => {
+                let linear = linear_below
+                    .as_mut()
+                    .and_then(|below| linear_step(model, below, zeta, y, h, &base, limit));
+                let outcome = match linear {
+                    Some(next) => next.map(|next| {
                         *y = next;
                         let stats = SolveStats {
                             accepted: 1,
                             ..SolveStats::default()
                         };
                         (stats, model.tank_force(y[state::X], y[state::V]))
-                    }
-                    None => match model.with_exponent(Interval {
+                    }),
+                    None => model.with_exponent(Interval {
                         integrator,
                         t,
                         h,
                         y,
                         limit,
-                    }) {
-                        Ok(done) => done,
-                        Err(e) => {
-                            (model.c, model.base) = previous;
-                            return Err(e);
-                        }
-                    },
+                    }),
+                };
+                let (stats, force) = match outcome {
+                    Ok(done) => done,
+                    Err(e) => {
+                        (model.c, model.base) = previous;
+                        return Err(e);
+                    }
                 };
                 let impulse = mass * (-(y[state::V] - v0) - base.integral(h));
                 (stats, impulse, Some(mass * force))
@@ -1300,7 +1304,8 @@ mod tests {
     }
 
     /// A step whose displacement leaves every physical range is refused after a successful
-    /// integration; the state and the integrator's carried step size stay as they were.
+    /// integration, or the exact linear step of model = Auto; the state and the integrator's
+    /// carried step size stay as they were.
     #[test]
     fn a_runaway_step_changes_nothing() {
         let adaptive = |kind| Method::Adaptive {
@@ -1308,7 +1313,7 @@ mod tests {
             rtol: 1e-8,
             max_step: 0.0,
         };
-        for method in [
+        for (model, method) in [
             adaptive(AdaptiveKind::DormandPrince),
             adaptive(AdaptiveKind::DormandPrince853),
             adaptive(AdaptiveKind::Sdirk4),
@@ -1329,9 +1334,19 @@ mod tests {
                 formula: FixedFormula::ExpRk4,
                 step: 0.01,
             },
-        ] {
+        ]
+        .into_iter()
+        .flat_map(|method| {
+            // With phi = 0 the Auto model never leaves its exact linear step.
+            [
+                ModelKind::Nonlinear,
+                ModelKind::NonlinearAuto { threshold: 0.0 },
+            ]
+            .map(|model| (model, method))
+        }) {
             // Linear (phi = 0), so that a huge input is integrated without trouble.
             let cfg = Config {
+                model,
                 phi: 0.0,
                 method,
                 ..config()
@@ -1346,9 +1361,9 @@ mod tests {
             let r = sim.step(0.013, 0.1, &push(-1e9));
             assert!(
                 matches!(r, Err(StepError::Runaway { .. })),
-                "{method:?}: {r:?}"
+                "{model:?} {method:?}: {r:?}"
             );
-            assert_eq!(sim, before, "{method:?}");
+            assert_eq!(sim, before, "{model:?} {method:?}");
             sim.step(0.013, 0.01, &push(0.3)).expect("usable after");
         }
     }
@@ -1362,26 +1377,25 @@ mod tests {
             formula,
             step: 0.004,
         };
-        let nonlinear = |model, eta, method| (model, eta, method);
         let dp45 = config().method;
         let mut cases = vec![];
         for eta in [1.0, 1.5, 2.0, 2.5, 3.0, 5.0] {
-            cases.push(nonlinear(ModelKind::Nonlinear, eta, dp45));
+            cases.push((ModelKind::Nonlinear, eta, dp45));
         }
         for method in [fixed(FixedFormula::Rk4), fixed(FixedFormula::ExpRk4)] {
-            cases.push(nonlinear(ModelKind::Nonlinear, 2.0, method));
+            cases.push((ModelKind::Nonlinear, 2.0, method));
         }
         // Mostly below the threshold: the exact linear step.
         let auto = ModelKind::NonlinearAuto { threshold: 1e-3 };
-        cases.push(nonlinear(auto, 2.0, dp45));
-        cases.push(nonlinear(ModelKind::Linear { modes: 3 }, 2.0, dp45));
+        cases.push((auto, 2.0, dp45));
+        cases.push((ModelKind::Linear { modes: 3 }, 2.0, dp45));
         let slamming = ModelKind::SloshingSlamming(SlammingParams {
             omega: 0.9,
             restitution: 0.4,
             clearance: 0.1,
             mass_ratio: 0.01,
         });
-        cases.push(nonlinear(slamming, 2.0, dp45));
+        cases.push((slamming, 2.0, dp45));
         for (model, eta, method) in cases {
             let cfg = Config {
                 model,
