@@ -764,12 +764,44 @@ impl Simulation {
     /// Advance by `h` > 0 from time `t`, the base acceleration following its Taylor polynomial
     /// from `inputs` (held when the derivatives are 0). All or nothing: on error the simulation
     /// is unchanged.
+    #[inline]
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<SolveStats, StepError> {
         // Only a tracked amplitude moves the damping; a fixed one was applied in new().
-        let (zeta, tracker) = match &self.tracker {
-            None => (self.zeta, None),
-            Some(tr) => self.track(tr, h, inputs),
-        };
+        match &self.tracker {
+            None => self.advance(self.zeta, t, h, inputs),
+            Some(tracker) => {
+                let mut tracker = tracker.clone();
+                tracker.update(h, inputs.a, inputs.v);
+                self.step_tracked(tracker, t, h, inputs)
+            }
+        }
+    }
+
+    /// [`Simulation::step`] with the amplitude tracker as it will be after the step.
+    #[inline(never)]
+    fn step_tracked(
+        &mut self,
+        tracker: AmplitudeTracker,
+        t: f64,
+        h: f64,
+        inputs: &Inputs,
+    ) -> Result<SolveStats, StepError> {
+        let stats = self.advance(self.config.zeta(tracker.estimate()), t, h, inputs)?;
+        self.amplitude = tracker.estimate();
+        self.tracker = Some(tracker);
+        Ok(stats)
+    }
+
+    /// [`Simulation::step`] with the damping ratio `zeta`: all but the amplitude tracker.
+    /// Out of line: one copy for both kinds of amplitude.
+    #[inline(never)]
+    fn advance(
+        &mut self,
+        zeta: f64,
+        t: f64,
+        h: f64,
+        inputs: &Inputs,
+    ) -> Result<SolveStats, StepError> {
         let [a1, a2] = inputs.a_derivatives;
         // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
         // input, and (t + h) - t is not h in floating point (at t = 3600 s and h = 1 ms, a
@@ -844,36 +876,8 @@ impl Simulation {
             }
         };
         self.force = force.unwrap_or_else(|| self.tank_force());
-        self.finish_step(zeta, tracker, impulse * inv_h, stats)
-    }
-
-    /// The amplitude tracker after a step of `h` under `inputs`, and the damping it gives.
-    #[inline(never)]
-    fn track(
-        &self,
-        tracker: &AmplitudeTracker,
-        h: f64,
-        inputs: &Inputs,
-    ) -> (f64, Option<AmplitudeTracker>) {
-        let mut tr = tracker.clone();
-        tr.update(h, inputs.a, inputs.v);
-        (self.config.zeta(tr.estimate()), Some(tr))
-    }
-
-    /// Commit what a successful step changed besides the model's state.
-    fn finish_step(
-        &mut self,
-        zeta: f64,
-        tracker: Option<AmplitudeTracker>,
-        mean_force: f64,
-        stats: SolveStats,
-    ) -> Result<SolveStats, StepError> {
-        self.last_mean_force = Some(mean_force);
+        self.last_mean_force = Some(impulse * inv_h);
         self.zeta = zeta;
-        if let Some(tr) = tracker {
-            self.amplitude = tr.estimate();
-            self.tracker = Some(tr);
-        }
         Ok(stats)
     }
 
