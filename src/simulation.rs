@@ -876,7 +876,14 @@ impl Simulation {
             }
         };
         self.force = force.unwrap_or_else(|| self.tank_force());
-        self.last_mean_force = Some(impulse * inv_h);
+        // 1/h overflows for a subnormal h (and 0 x inf is NaN): over so short a step the mean
+        // force is the force.
+        let mean_force = impulse * inv_h;
+        self.last_mean_force = Some(if mean_force.is_finite() {
+            mean_force
+        } else {
+            self.force
+        });
         self.zeta = zeta;
         Ok(stats)
     }
@@ -1389,8 +1396,8 @@ mod tests {
         for method in [fixed(FixedFormula::Rk4), fixed(FixedFormula::ExpRk4)] {
             cases.push((ModelKind::Nonlinear, 2.0, method));
         }
-        // Mostly below the threshold: the exact linear step.
-        let auto = ModelKind::NonlinearAuto { threshold: 1e-3 };
+        // Below the threshold (the exact linear step) while the motion is small, above it later.
+        let auto = ModelKind::NonlinearAuto { threshold: 0.1 };
         cases.push((auto, 2.0, dp45));
         cases.push((ModelKind::Linear { modes: 3 }, 2.0, dp45));
         let slamming = ModelKind::SloshingSlamming(SlammingParams {
@@ -1421,10 +1428,17 @@ mod tests {
                     sim.tank_force()
                 );
                 assert_ne!(kept, 0.0, "{model:?}: a state with a force");
+                // x and v: the (first) sloshing mode's, first in the snapshot.
+                let snapshot = sim.snapshot();
+                for (which, k) in [(Output::X, 0), (Output::V, 1)] {
+                    let got = sim.output(which, &Inputs::default());
+                    assert_eq!(got.to_bits(), snapshot[k].to_bits(), "{model:?} {which:?}");
+                }
             };
             let (mut sim, _) = Simulation::new(cfg).expect("config");
             same(&sim, "start");
             let mut zetas = vec![];
+            let mut linear_steps = 0;
             for k in 0..300 {
                 let t = f64::from(k) * 0.01;
                 let inputs = Inputs {
@@ -1432,9 +1446,17 @@ mod tests {
                     v: -0.3 / 5.6 * (5.6 * t).cos(),
                     ..Inputs::default()
                 };
-                sim.step(t, 0.01, &inputs).expect("step");
+                let stats = sim.step(t, 0.01, &inputs).expect("step");
                 same(&sim, &format!("step {k}"));
                 zetas.push(sim.zeta);
+                // The exact linear step of model = Auto evaluates nothing.
+                linear_steps += usize::from(stats.evaluations == 0);
+            }
+            if matches!(model, ModelKind::NonlinearAuto { .. }) {
+                assert!(
+                    linear_steps > 0 && linear_steps < 300,
+                    "{model:?}: both kinds of step ({linear_steps} linear)"
+                );
             }
             assert_ne!(zetas[299], zetas[298], "{model:?}: the damping moves");
             let refused = sim.step(
@@ -1454,6 +1476,62 @@ mod tests {
             let restored = Simulation::restore(cfg, &sim.snapshot()).expect("restore");
             same(&restored, "restored");
             assert_eq!(restored.force.to_bits(), sim.force.to_bits());
+        }
+    }
+
+    /// The shortest step there is (h = 5e-324, 1/h = inf) is taken, every output stays finite,
+    /// and the simulation goes on; for every model.
+    #[test]
+    fn a_subnormal_step_gives_finite_outputs() {
+        let rk4 = Method::Fixed {
+            formula: FixedFormula::Rk4,
+            step: 0.01,
+        };
+        let slamming = ModelKind::SloshingSlamming(SlammingParams {
+            omega: 0.9,
+            restitution: 0.4,
+            clearance: 0.1,
+            mass_ratio: 0.01,
+        });
+        for (model, method) in [
+            (ModelKind::Nonlinear, config().method),
+            (ModelKind::Nonlinear, rk4),
+            (ModelKind::NonlinearAuto { threshold: 0.0 }, config().method),
+            (ModelKind::Linear { modes: 2 }, config().method),
+            (slamming, config().method),
+        ] {
+            let cfg = Config {
+                model,
+                method,
+                x0: 0.02,
+                v0: 0.1,
+                ..config()
+            };
+            let (mut sim, _) = Simulation::new(cfg).expect("config");
+            let inputs = Inputs {
+                a: 0.3,
+                ..Inputs::default()
+            };
+            sim.step(0.0, 5e-324, &inputs).expect("a subnormal step");
+            for which in [
+                Output::Force,
+                Output::ForceMean,
+                Output::BaseShear,
+                Output::X,
+                Output::V,
+                Output::EnergyInput,
+                Output::EnergyDissipated,
+                Output::EnergyStored,
+                Output::Amplitude,
+                Output::Zeta,
+                Output::ImpactZ,
+                Output::Impacts,
+            ] {
+                let value = sim.output(which, &inputs);
+                assert!(value.is_finite(), "{model:?} {method:?} {which:?}: {value}");
+            }
+            sim.step(5e-324, 0.01, &inputs)
+                .expect("an ordinary step after");
         }
     }
 
