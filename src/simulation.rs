@@ -1230,6 +1230,16 @@ mod tests {
         }
     }
 
+    /// The S^2 model the tests run: Omega 0.9, a 0.1 m clearance.
+    fn slamming() -> ModelKind {
+        ModelKind::SloshingSlamming(SlammingParams {
+            omega: 0.9,
+            restitution: 0.4,
+            clearance: 0.1,
+            mass_ratio: 0.01,
+        })
+    }
+
     /// Free decay of the linear limit against the closed-form damped oscillation.
     #[test]
     fn linear_free_decay_matches_closed_form() {
@@ -1400,13 +1410,7 @@ mod tests {
         let auto = ModelKind::NonlinearAuto { threshold: 0.1 };
         cases.push((auto, 2.0, dp45));
         cases.push((ModelKind::Linear { modes: 3 }, 2.0, dp45));
-        let slamming = ModelKind::SloshingSlamming(SlammingParams {
-            omega: 0.9,
-            restitution: 0.4,
-            clearance: 0.1,
-            mass_ratio: 0.01,
-        });
-        cases.push((slamming, 2.0, dp45));
+        cases.push((slamming(), 2.0, dp45));
         for (model, eta, method) in cases {
             let cfg = Config {
                 model,
@@ -1487,18 +1491,12 @@ mod tests {
             formula: FixedFormula::Rk4,
             step: 0.01,
         };
-        let slamming = ModelKind::SloshingSlamming(SlammingParams {
-            omega: 0.9,
-            restitution: 0.4,
-            clearance: 0.1,
-            mass_ratio: 0.01,
-        });
         for (model, method) in [
             (ModelKind::Nonlinear, config().method),
             (ModelKind::Nonlinear, rk4),
             (ModelKind::NonlinearAuto { threshold: 0.0 }, config().method),
             (ModelKind::Linear { modes: 2 }, config().method),
-            (slamming, config().method),
+            (slamming(), config().method),
         ] {
             let cfg = Config {
                 model,
@@ -1542,12 +1540,7 @@ mod tests {
         for model in [
             ModelKind::Nonlinear,
             ModelKind::Linear { modes: 2 },
-            ModelKind::SloshingSlamming(SlammingParams {
-                omega: 0.9,
-                restitution: 0.4,
-                clearance: 0.1,
-                mass_ratio: 0.01,
-            }),
+            slamming(),
         ] {
             let cfg = Config {
                 model,
