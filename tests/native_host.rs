@@ -5,11 +5,7 @@ mod common;
 use common::*;
 use std::ffi::CString;
 use tld_fmu::fmi::vars::{GUID, vr};
-use tld_fmu::physics::geometry::Tank;
-use tld_fmu::physics::laws::{DampingLaw, LambdaRange};
-use tld_fmu::simulation::{
-    AdaptiveKind, AmplitudeSource, Config, Inputs, Method, ModelKind, Output, Simulation,
-};
+use tld_fmu::model::{Damper, Inputs, Output, StartValues};
 
 /// The FMI layer adds nothing and loses nothing: the same run through the C interface and
 /// directly through the simulation is bit-identical.
@@ -18,28 +14,8 @@ fn fmi_layer_is_transparent() {
     let mut inst = Instance::new("transparent");
     inst.initialise();
     let x_fmu = inst.run_harmonic(500, 0.01);
-    let (mut sim, _) = Simulation::new(Config {
-        model: ModelKind::Nonlinear,
-        tank: Tank::TABLE_2_1,
-        tanks: 1,
-        eta: 2.0,
-        phi: 1.0,
-        damping: DampingLaw::Nsd { c: 0.5, p: 0.35 },
-        lambda: LambdaRange {
-            min: 1e-3,
-            max: 0.1,
-        },
-        amplitude: AmplitudeSource::Fixed(0.005),
-        x0: 0.0,
-        v0: 0.0,
-        method: Method::Adaptive {
-            kind: AdaptiveKind::DormandPrince,
-            rtol: 1e-10,
-            max_step: 0.0,
-        },
-        max_substeps: 100_000,
-    })
-    .expect("defaults");
+    // The model description's defaults, which the instance runs too.
+    let (mut sim, _) = Damper::configure(&StartValues::default()).expect("defaults");
     let w = 6.0;
     let mut t = 0.0;
     for _ in 0..500 {

@@ -4,10 +4,12 @@
 use std::ffi::CString;
 
 use super::logger::Logger;
-use super::params::{Source, Values, derived_value, free_real_input, output_of, source_of};
+use super::params::{
+    Configuration, Source, Values, derived_value, free_real_input, output_of, source_of,
+};
 use super::snapshot::Saved;
 use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, finite, index_of, vr};
-use crate::simulation::{Inputs, Output, Simulation, StepError};
+use crate::model::{Damper, Inputs, Output, StepError};
 use crate::solver::SolveError;
 
 /// fmi2Status, as a Rust enum.
@@ -120,7 +122,7 @@ struct Restored {
     user_tolerance: bool,
     time: f64,
     a_derivatives: [f64; 2],
-    sim: Option<Simulation>,
+    sim: Option<Damper>,
 }
 
 pub struct Instance {
@@ -136,7 +138,7 @@ pub struct Instance {
     time: f64,
     /// Derivatives of base.a (orders 1 and 2) for the next step only.
     a_derivatives: [f64; 2],
-    sim: Option<Simulation>,
+    sim: Option<Damper>,
 }
 
 impl Instance {
@@ -342,19 +344,26 @@ impl Instance {
         Ok(Status::Ok)
     }
 
-    fn build(&self) -> Result<(Simulation, Vec<String>), Refusal> {
-        let config = self
-            .values
-            .config(self.experiment.tolerance, self.user_tolerance);
-        Simulation::new(config).map_err(|e| refuse(format!("the parameters are inconsistent: {e}")))
+    fn build(&self) -> Result<(Damper, Vec<String>), Refusal> {
+        Damper::configure(&self.configuration())
+            .map_err(|e| refuse(format!("the parameters are inconsistent: {e}")))
+    }
+
+    /// The parameters as the models read them.
+    fn configuration(&self) -> Configuration<'_> {
+        Configuration {
+            values: &self.values,
+            tolerance: self.experiment.tolerance,
+            user_tolerance: self.user_tolerance,
+        }
     }
 
     /// The running simulation, or during initialisation one built on the parameters set so
     /// far (kept in `provisional` for the rest of the call).
     fn simulation<'a>(
         &'a self,
-        provisional: &'a mut Option<Simulation>,
-    ) -> Result<&'a Simulation, Refusal> {
+        provisional: &'a mut Option<Damper>,
+    ) -> Result<&'a Damper, Refusal> {
         if let Some(sim) = &self.sim {
             return Ok(sim);
         }
@@ -420,10 +429,8 @@ impl Instance {
                     None => self.output_before_init(which, &inputs)?,
                 },
                 Source::Derived => {
-                    let derived = match &self.sim {
-                        Some(sim) => sim.derived(),
-                        None => self.values.config(None, false).derived(),
-                    };
+                    let mut provisional = None;
+                    let derived = self.simulation(&mut provisional)?.derived();
                     derived_value(r, &derived).ok_or_else(|| Self::no_value(r, function))?
                 }
                 Source::NoValue(_) => return Err(Self::no_value(r, function)),
@@ -448,7 +455,7 @@ impl Instance {
     /// written that matters: the general path then writes every value or refuses) when a
     /// pointer is null or misaligned, calls are logged, the state does not allow gets, there is
     /// no simulation yet, or a variable is anything but a stored Real or an output of
-    /// [`Simulation::per_step_output`].
+    /// [`Damper::per_step_output`].
     ///
     /// # Safety
     /// `vr` and `value`, when not null, must point to `nvr` elements each.
@@ -725,11 +732,7 @@ impl Instance {
             time: self.time,
             a_derivatives: self.a_derivatives,
             values: self.values.as_slice().to_vec(),
-            simulation: self
-                .sim
-                .as_ref()
-                .map(Simulation::snapshot)
-                .unwrap_or_default(),
+            simulation: self.sim.as_ref().map(Damper::snapshot).unwrap_or_default(),
         }
         .encode()
     }
@@ -775,8 +778,12 @@ impl Instance {
         let values = Values::from_saved(&s.values).map_err(bad)?;
         let initialised = matches!(phase, Phase::StepComplete | Phase::Terminated);
         let sim = if initialised {
-            let config = values.config(s.tolerance, s.user_tolerance);
-            Some(Simulation::restore(config, &s.simulation).map_err(bad)?)
+            let configuration = Configuration {
+                values: &values,
+                tolerance: s.tolerance,
+                user_tolerance: s.user_tolerance,
+            };
+            Some(Damper::restore(&configuration, &s.simulation).map_err(bad)?)
         } else if s.simulation.is_empty() {
             None
         } else {

@@ -6,6 +6,8 @@ mod instance;
 mod logger;
 mod params;
 mod snapshot;
-pub mod vars;
+
+/// The model description's table, where the FMI layer has always offered it.
+pub use crate::description as vars;
 
 pub use instance::Status;

@@ -2,12 +2,7 @@
 //! maps FMI variable names onto the simulation's inputs and outputs.
 
 use super::vars::{Causality, VARIABLES, VR_INDEX, VarType, index_of, vr};
-use crate::physics::geometry::Tank;
-use crate::physics::laws::{DampingLaw, LambdaRange};
-use crate::simulation::{
-    AdaptiveKind, AmplitudeSource, Config, Derived, FixedFormula, Inputs, Method, ModelKind,
-    Output, SlammingParams,
-};
+use crate::model::{Derived, Inputs, Output, Parameters};
 
 /// Values of all variables, in the order of `VARIABLES` (integers and enumerations as f64).
 #[derive(Clone, Debug, PartialEq)]
@@ -22,7 +17,6 @@ const fn slot(vr: u32) -> usize {
 }
 const BASE_A: usize = slot(vr::BASE_A);
 const BASE_V: usize = slot(vr::BASE_V);
-const BASE_X: usize = slot(vr::BASE_X);
 
 impl Values {
     /// Start values from the model description (NaN where a variable has none).
@@ -80,100 +74,44 @@ impl Values {
         Inputs {
             a: self.0[BASE_A],
             v: self.0[BASE_V],
-            x: self.0[BASE_X],
             a_derivatives,
         }
     }
+}
 
-    /// An enumeration's value, or its Integer alias when that is set (hosts that cannot set
-    /// Enumeration variables, such as libcosim, use the alias).
-    fn option(&self, enumeration: u32, alias: u32) -> f64 {
-        let a = self.get(alias);
-        if a > 0.0 { a } else { self.get(enumeration) }
-    }
+/// The Integer aliases that override enumerations (hosts that cannot set Enumeration variables,
+/// such as libcosim, use the alias); 0, their start value, leaves the enumeration in force.
+const ALIASES: [(u32, u32); 4] = [
+    (vr::MODEL, vr::MODEL_ID),
+    (vr::DAMPING, vr::DAMPING_ID),
+    (vr::AMPLITUDE, vr::AMPLITUDE_ID),
+    (vr::SOLVER, vr::SOLVER_ID),
+];
 
-    /// The configuration these values describe. `tolerance` is the experiment's tolerance, used
-    /// unless the user set solver.tolerance explicitly.
-    pub fn config(&self, tolerance: Option<f64>, user_tolerance: bool) -> Config {
-        let g = |r| self.get(r);
-        let damping = if self.option(vr::DAMPING, vr::DAMPING_ID) == 1.0 {
-            DampingLaw::Constant(g(vr::ZETA))
-        } else {
-            DampingLaw::Nsd {
-                c: g(vr::NSD_C),
-                p: g(vr::NSD_P),
-            }
-        };
-        let amplitude = if self.option(vr::AMPLITUDE, vr::AMPLITUDE_ID) == 2.0 {
-            AmplitudeSource::Tracked {
-                tau: g(vr::AMPLITUDE_TAU),
-                prior: g(vr::A_E),
-            }
-        } else {
-            AmplitudeSource::Fixed(g(vr::A_E))
-        };
-        let rtol = match tolerance {
-            Some(tol) if !user_tolerance => tol,
-            _ => g(vr::SOLVER_TOLERANCE),
-        };
-        // The items of the SolverMethod enumeration (modelDescription.xml).
-        let adaptive = |kind| Method::Adaptive {
-            kind,
-            rtol,
-            max_step: g(vr::SOLVER_MAX_STEP),
-        };
-        let fixed = |formula| Method::Fixed {
-            formula,
-            step: g(vr::SOLVER_FIXED_STEP),
-        };
-        let method = match self.option(vr::SOLVER, vr::SOLVER_ID) as i64 {
-            2 => fixed(FixedFormula::Rk4),
-            3 => adaptive(AdaptiveKind::Sdirk4),
-            4 => adaptive(AdaptiveKind::Auto),
-            5 => adaptive(AdaptiveKind::DormandPrince853),
-            6 => fixed(FixedFormula::Rk5),
-            7 => fixed(FixedFormula::Rk8),
-            8 => fixed(FixedFormula::ExpRk4),
-            _ => adaptive(AdaptiveKind::DormandPrince),
-        };
-        let model = match self.option(vr::MODEL, vr::MODEL_ID) as i64 {
-            1 => ModelKind::Linear {
-                modes: g(vr::MODES) as u32,
-            },
-            3 => ModelKind::SloshingSlamming(SlammingParams {
-                omega: g(vr::SLAMMING_OMEGA),
-                restitution: g(vr::SLAMMING_RESTITUTION),
-                clearance: g(vr::SLAMMING_CLEARANCE),
-                mass_ratio: g(vr::SLAMMING_MASS_RATIO),
-            }),
-            4 => ModelKind::NonlinearAuto {
-                threshold: g(vr::AUTO_THRESHOLD),
-            },
-            _ => ModelKind::Nonlinear,
-        };
-        Config {
-            model,
-            tank: Tank {
-                length: g(vr::TANK_LENGTH),
-                breadth: g(vr::TANK_BREADTH),
-                depth: g(vr::TANK_DEPTH),
-                density: g(vr::LIQUID_DENSITY),
-                g: g(vr::G),
-            },
-            tanks: g(vr::TANKS) as u32,
-            eta: g(vr::ETA),
-            phi: g(vr::PHI),
-            damping,
-            lambda: LambdaRange {
-                min: g(vr::LAMBDA_MIN),
-                max: g(vr::LAMBDA_MAX),
-            },
-            amplitude,
-            x0: g(vr::SLOSH_X0),
-            v0: g(vr::SLOSH_V0),
-            method,
-            max_substeps: g(vr::SOLVER_MAX_SUBSTEPS) as u64,
+/// The parameters as the models read them: the values the host set, each enumeration
+/// overridden by its Integer alias when that is set, and the experiment's tolerance in place of
+/// solver.tolerance unless the user set that explicitly.
+pub struct Configuration<'a> {
+    pub values: &'a Values,
+    pub tolerance: Option<f64>,
+    pub user_tolerance: bool,
+}
+
+impl Parameters for Configuration<'_> {
+    fn value(&self, r: u32) -> f64 {
+        if r == vr::SOLVER_TOLERANCE
+            && let Some(tol) = self.tolerance
+            && !self.user_tolerance
+        {
+            return tol;
         }
+        if let Some(&(_, alias)) = ALIASES.iter().find(|(e, _)| *e == r) {
+            let a = self.values.get(alias);
+            if a > 0.0 {
+                return a;
+            }
+        }
+        self.values.get(r)
     }
 }
 
@@ -300,4 +238,44 @@ pub const fn output_of(vr: u32) -> Option<Output> {
         vr::IMPACTS => Output::Impacts,
         _ => return None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn slot_of(r: u32) -> usize {
+        index_of(r).expect("a declared variable")
+    }
+
+    /// The models see each enumeration through its Integer alias once that is set, and the
+    /// experiment's tolerance unless solver.tolerance was set explicitly.
+    #[test]
+    fn the_models_see_aliases_and_the_experiments_tolerance() {
+        let mut values = Values::start();
+        let seen = |values: &Values, user_tolerance| {
+            let c = Configuration {
+                values,
+                tolerance: Some(1e-6),
+                user_tolerance,
+            };
+            (
+                ALIASES.map(|(e, _)| c.value(e)),
+                c.value(vr::SOLVER_TOLERANCE),
+            )
+        };
+        let starts = ALIASES.map(|(e, _)| values.get(e));
+        assert_eq!(seen(&values, false), (starts, 1e-6));
+        assert_eq!(seen(&values, true).1, values.get(vr::SOLVER_TOLERANCE));
+        for (k, (enumeration, alias)) in ALIASES.into_iter().enumerate() {
+            // An item other than the enumeration's own value.
+            let other = if values.get(enumeration) == 1.0 {
+                2.0
+            } else {
+                1.0
+            };
+            values.set_at(slot_of(alias), other);
+            assert_eq!(seen(&values, false).0[k], other, "alias of {enumeration}");
+        }
+    }
 }

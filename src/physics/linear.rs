@@ -3,7 +3,7 @@
 //! base acceleration that is a polynomial of degree <= 2 over the step (held, or interpolated
 //! from input derivatives): no integration error whatever the step.
 
-use super::nonlinear::BaseAcceleration;
+use super::base::BaseAcceleration;
 
 /// One mode's exact propagator: x(s) = C(s) x0 + S(s) (v0 + sigma x0) for the free motion,
 /// with sigma = zeta omega, C = e^(-sigma s) cos(mu s), S = e^(-sigma s) sin(mu s)/mu and

@@ -2,6 +2,7 @@
 //! Plain Rust: no FFI and nothing of FMI here.
 
 pub mod amplitude;
+pub mod base;
 pub mod geometry;
 pub mod laws;
 pub mod linear;

@@ -11,7 +11,7 @@
 //! then rests on the wall for as long as the base acceleration presses it there, pushing on the
 //! tank with -a_b per unit mass, and leaves when the acceleration turns.
 
-use super::nonlinear::BaseAcceleration;
+use super::base::BaseAcceleration;
 
 /// Impacts in one step before the step is refused (chattering that does not end).
 const MAX_IMPACTS_PER_STEP: u64 = 100_000;

@@ -1,0 +1,258 @@
+//! The damper an instance runs: the chosen model and what every model shares around it, the
+//! damping law and its amplitude (fixed or tracked online), the mean force of the last step, the
+//! energy at the start, and the frame of the saved state.
+
+use super::{
+    AmplitudeSource, AnyModel, Common, Derived, Inputs, Interval, Observable, Output, Parameters,
+    Start, StepError,
+};
+use crate::description::vr;
+use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
+use crate::physics::base::BaseAcceleration;
+use crate::solver::SolveStats;
+
+/// Numbers of a saved state after the model's own: amplitude, mean force (flag and value),
+/// amplitude estimator.
+const FRAME: usize = 3 + TRACKER_STATE;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Damper {
+    common: Common,
+    derived: Derived,
+    model: AnyModel,
+    tracker: Option<AmplitudeTracker>,
+    /// Stored energy at the start [J]: counted as input.
+    initial_energy: f64,
+    amplitude: f64,
+    /// Damping ratio in use.
+    zeta: f64,
+    last_mean_force: Option<f64>,
+    /// Force of the liquid on the tanks at the current state [N], kept with the state: a master
+    /// reads it after every step, where it is a load.
+    force: f64,
+}
+
+impl Damper {
+    /// The damper the parameters describe, and warnings about them; Err: they cannot be
+    /// simulated, with the reason.
+    pub fn configure(p: &dyn Parameters) -> Result<(Self, Vec<String>), String> {
+        let (common, warnings) = Common::read(p)?;
+        let omega_f = common.tank.fundamental().omega;
+        let (amplitude, tracker) = match common.amplitude {
+            AmplitudeSource::Fixed(a_e) => (a_e, None),
+            AmplitudeSource::Tracked { tau, prior } => {
+                let period = 2.0 * std::f64::consts::PI / omega_f;
+                let tau = if tau > 0.0 { tau } else { 2.0 * period };
+                // The velocity rebuild leaks at w_f/20: 0.5 % gain error at w_f/2, undone exactly.
+                (
+                    prior,
+                    Some(AmplitudeTracker::new(tau, 0.05 * omega_f, prior)),
+                )
+            }
+        };
+        let zeta = common.zeta(amplitude);
+        let model = AnyModel::configure(p.item(vr::MODEL), p, &common, Start { zeta, amplitude })?;
+        let mass_liquid = common.liquid_mass();
+        let mass_slosh = model.sloshing_mass();
+        let derived = Derived {
+            omega_f,
+            mass_liquid,
+            mass_slosh,
+            mass_inactive: mass_liquid - mass_slosh,
+        };
+        let damper = Damper {
+            common,
+            derived,
+            initial_energy: model.observe(Observable::Stored),
+            force: model.force(),
+            model,
+            tracker,
+            amplitude,
+            zeta,
+            last_mean_force: None,
+        };
+        Ok((damper, warnings))
+    }
+
+    pub fn derived(&self) -> Derived {
+        self.derived
+    }
+
+    /// Advance by `h` > 0 from time `t`, the base acceleration following its Taylor polynomial
+    /// from `inputs` (held when the derivatives are 0). All or nothing: on error the damper is
+    /// unchanged.
+    #[inline]
+    pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<SolveStats, StepError> {
+        // Only a tracked amplitude moves the damping; a fixed one was applied in configure.
+        match &self.tracker {
+            None => self.advance(self.zeta, t, h, inputs),
+            Some(tracker) => {
+                let mut tracker = tracker.clone();
+                tracker.update(h, inputs.a, inputs.v);
+                self.step_tracked(tracker, t, h, inputs)
+            }
+        }
+    }
+
+    /// [`Damper::step`] with the amplitude tracker as it will be after the step.
+    #[inline(never)]
+    fn step_tracked(
+        &mut self,
+        tracker: AmplitudeTracker,
+        t: f64,
+        h: f64,
+        inputs: &Inputs,
+    ) -> Result<SolveStats, StepError> {
+        let stats = self.advance(self.common.zeta(tracker.estimate()), t, h, inputs)?;
+        self.amplitude = tracker.estimate();
+        self.tracker = Some(tracker);
+        Ok(stats)
+    }
+
+    /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker. Out of
+    /// line: one copy for both kinds of amplitude.
+    #[inline(never)]
+    fn advance(
+        &mut self,
+        zeta: f64,
+        t: f64,
+        h: f64,
+        inputs: &Inputs,
+    ) -> Result<SolveStats, StepError> {
+        // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
+        // input, and (t + h) - t is not h in floating point.
+        let step = Interval {
+            t,
+            h,
+            zeta,
+            base: BaseAcceleration {
+                t0: 0.0,
+                a: [inputs.a, inputs.a_derivatives[0], inputs.a_derivatives[1]],
+            },
+            limit: 100.0 * self.common.tank.length,
+        };
+        // 1/h is ready long before the step's impulse is.
+        let inv_h = 1.0 / h;
+        let stepped = self.model.step(&step)?;
+        self.force = stepped.force;
+        // 1/h overflows for a subnormal h (and 0 x inf is NaN): over so short a step the mean
+        // force is the force.
+        let mean_force = stepped.impulse * inv_h;
+        self.last_mean_force = Some(if mean_force.is_finite() {
+            mean_force
+        } else {
+            self.force
+        });
+        self.zeta = zeta;
+        Ok(stepped.stats)
+    }
+
+    /// The output `which` now.
+    #[inline]
+    pub fn output(&self, which: Output, inputs: &Inputs) -> f64 {
+        self.per_step_output(which)
+            .unwrap_or_else(|| self.other_output(which, inputs))
+    }
+
+    /// The output `which` if it is one of the three a master reads after every step: loads,
+    /// with no call and nothing that can panic. None for the others.
+    #[inline(always)]
+    pub fn per_step_output(&self, which: Output) -> Option<f64> {
+        match which {
+            Output::X => Some(self.model.sloshing().0),
+            Output::V => Some(self.model.sloshing().1),
+            Output::Force => Some(self.force),
+            _ => None,
+        }
+    }
+
+    /// Every output but those of [`Damper::per_step_output`].
+    #[inline(never)]
+    fn other_output(&self, which: Output, inputs: &Inputs) -> f64 {
+        let observe = |o| self.model.observe(o);
+        match which {
+            Output::X | Output::V | Output::Force => self.per_step_output(which).unwrap_or(0.0),
+            Output::ForceMean => self.last_mean_force.unwrap_or(self.force),
+            Output::BaseShear => {
+                self.force
+                    - self.derived.mass_inactive * inputs.a
+                    - self.model.rigid_mass() * inputs.a
+            }
+            Output::EnergyInput => self.initial_energy + observe(Observable::WorkIn),
+            Output::EnergyDissipated => observe(Observable::Dissipated),
+            Output::EnergyStored => observe(Observable::Stored),
+            Output::Amplitude => self.amplitude,
+            Output::Zeta => self.zeta,
+            Output::ImpactZ => observe(Observable::ImpactZ),
+            Output::Impacts => observe(Observable::Impacts),
+        }
+    }
+
+    /// The exact first time derivative of the output `which` now (0 for quantities constant
+    /// between communication points; the impacts themselves are instants, not rates).
+    pub fn output_derivative(&self, which: Output, inputs: &Inputs) -> f64 {
+        let (a, a_rate) = (inputs.a, inputs.a_derivatives[0]);
+        match which {
+            Output::BaseShear => {
+                self.model.rate(Output::Force, a, a_rate)
+                    - (self.derived.mass_inactive + self.model.rigid_mass()) * a_rate
+            }
+            _ => self.model.rate(which, a, a_rate),
+        }
+    }
+
+    /// Everything that evolves, as a flat list of numbers (what the parameters do not
+    /// determine): the model's part, then the frame. Restore with [`Damper::restore`] and the
+    /// same parameters.
+    pub fn snapshot(&self) -> Vec<f64> {
+        let mut out = Vec::with_capacity(self.model.state_len() + FRAME);
+        self.model.save(&mut out);
+        out.push(self.amplitude);
+        out.push(f64::from(u8::from(self.last_mean_force.is_some())));
+        out.push(self.last_mean_force.unwrap_or(0.0));
+        out.extend_from_slice(
+            &self
+                .tracker
+                .as_ref()
+                .map_or([0.0; TRACKER_STATE], |t| t.state()),
+        );
+        out
+    }
+
+    /// The damper the parameters `p` describe, in the state `snapshot` recorded.
+    pub fn restore(p: &dyn Parameters, snapshot: &[f64]) -> Result<Self, String> {
+        let (mut damper, _) = Damper::configure(p)?;
+        let n = damper.model.state_len();
+        if snapshot.len() != n + FRAME {
+            return Err(format!(
+                "a state of this model has {} numbers, this one {}",
+                n + FRAME,
+                snapshot.len()
+            ));
+        }
+        if snapshot.iter().any(|v| !v.is_finite()) {
+            return Err("the state holds non-finite numbers".into());
+        }
+        let (model_state, frame) = snapshot.split_at(n);
+        damper.model.load(model_state)?;
+        damper.amplitude = frame[0];
+        damper.last_mean_force = match frame[1] {
+            0.0 => None,
+            1.0 => Some(frame[2]),
+            _ => return Err("the state's mean-force flag is neither 0 nor 1".into()),
+        };
+        if let Some(tracker) = damper.tracker.as_mut() {
+            let mut t = [0.0; TRACKER_STATE];
+            t.copy_from_slice(&frame[3..]);
+            tracker.set_state(&t)?;
+        }
+        // The damping the last step used, which the model keeps for the output rates.
+        damper.zeta = damper.common.zeta(damper.amplitude);
+        damper.model.set_damping(damper.zeta);
+        damper.force = damper.model.force();
+        Ok(damper)
+    }
+}
+
+#[cfg(test)]
+mod tests;

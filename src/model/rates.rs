@@ -1,0 +1,52 @@
+//! Exact output rates of models made of oscillators: each a mass on a spring and damper driven
+//! by the base, x'' = -a - c x' - f(x), whose force on the tank is c x' + f(x).
+
+use super::Output;
+
+/// One oscillator now: mass [kg], x, v, damping c [1/s], restoring force per unit mass f(x)
+/// and its slope f'(x).
+#[derive(Clone, Copy, Debug)]
+pub struct Oscillator {
+    pub mass: f64,
+    pub x: f64,
+    pub v: f64,
+    pub c: f64,
+    pub restoring: f64,
+    pub slope: f64,
+}
+
+impl Oscillator {
+    /// x'' under base acceleration `a`.
+    fn acceleration(&self, a: f64) -> f64 {
+        -a - self.c * self.v - self.restoring
+    }
+}
+
+/// The rate of `which` for `oscillators` (the first the fundamental one) and `free` masses that
+/// move with no spring or damper (mass, velocity), under base acceleration `a`. Outputs that
+/// are not made of these (mean force, base shear, amplitude, ...) are 0 here.
+pub fn rate(which: Output, oscillators: &[Oscillator], free: &[(f64, f64)], a: f64) -> f64 {
+    let each = |f: &dyn Fn(&Oscillator) -> f64| oscillators.iter().map(f).sum::<f64>();
+    match which {
+        // d/dt (c v + f(x)) = c v' + f'(x) v.
+        Output::Force => each(&|o| o.mass * (o.c * o.acceleration(a) + o.slope * o.v)),
+        Output::X => oscillators.first().map_or(0.0, |o| o.v),
+        Output::V => oscillators.first().map_or(0.0, |o| o.acceleration(a)),
+        // Power of the base on each mass, -m a v.
+        Output::EnergyInput => {
+            each(&|o| -o.mass * a * o.v) + free.iter().map(|(m, v)| -m * a * v).sum::<f64>()
+        }
+        Output::EnergyDissipated => each(&|o| o.mass * o.c * o.v * o.v),
+        // d/dt (v^2/2 + V(x)) = v (v' + f(x)).
+        Output::EnergyStored => {
+            each(&|o| o.mass * o.v * (o.acceleration(a) + o.restoring))
+                + free.iter().map(|(m, v)| m * v * -a).sum::<f64>()
+        }
+        Output::ForceMean
+        | Output::BaseShear
+        | Output::Amplitude
+        | Output::Zeta
+        | Output::ImpactZ
+        | Output::Impacts => 0.0,
+    }
+}

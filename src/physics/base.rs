@@ -1,0 +1,34 @@
+//! The base (tank) motion that drives every model over one communication step.
+
+/// Base (tank) acceleration over one communication step: a Taylor polynomial about the step's
+/// start t0, a(t) = a0 + a1 (t - t0) + a2 (t - t0)^2 / 2. Held input: a1 = a2 = 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BaseAcceleration {
+    pub t0: f64,
+    pub a: [f64; 3],
+}
+
+impl BaseAcceleration {
+    pub fn held(a0: f64) -> Self {
+        BaseAcceleration {
+            t0: 0.0,
+            a: [a0, 0.0, 0.0],
+        }
+    }
+
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        // Held input, the usual case, by a predictable branch: no polynomial on the path of
+        // every stage (the value is the same: a0 + s (0 + 0.5 s 0) = a0 for finite s).
+        if self.a[1] == 0.0 && self.a[2] == 0.0 {
+            return self.a[0];
+        }
+        let s = t - self.t0;
+        self.a[0] + s * (self.a[1] + 0.5 * s * self.a[2])
+    }
+
+    /// Integral of a from t0 to t0 + h.
+    pub fn integral(&self, h: f64) -> f64 {
+        h * (self.a[0] + h * (0.5 * self.a[1] + h * self.a[2] * (1.0 / 6.0)))
+    }
+}
