@@ -4,7 +4,7 @@
 //! integrator otherwise.
 
 use super::check_runaway;
-use super::nonlinear::Nonlinear;
+use super::nonlinear::{Nonlinear, Shortcut};
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
 use crate::description::vr;
 use crate::physics::linear::{Mode, ModeState};
@@ -13,10 +13,26 @@ use crate::physics::nonlinear::{NonlinearTld, state};
 #[derive(Clone, Debug, PartialEq)]
 pub struct NonlinearAuto {
     nonlinear: Nonlinear,
-    /// The hardening below which a step is taken by the linear propagator.
+    linear: LinearBelow,
+}
+
+/// The exact linear step while the hardening stays below `threshold`.
+#[derive(Clone, Debug, PartialEq)]
+struct LinearBelow {
     threshold: f64,
-    /// That propagator (kept for its cached coefficients).
-    linear: Mode,
+    /// The linear propagator (kept for its cached coefficients).
+    mode: Mode,
+}
+
+impl Shortcut for LinearBelow {
+    fn step(
+        &mut self,
+        tld: &NonlinearTld,
+        y: &[f64; state::DIM],
+        step: &Interval,
+    ) -> Option<Result<[f64; state::DIM], StepError>> {
+        linear_step(tld, (self.threshold, &mut self.mode), y, step)
+    }
 }
 
 /// The nonlinear state advanced by the exact linear solution, if the hardening stays below
@@ -63,11 +79,10 @@ impl Model for NonlinearAuto {
             t if t > 0.0 => t,
             _ => nonlinear.method.tolerance(),
         };
-        let linear = Mode::new(common.tank.fundamental().omega, start.zeta);
+        let mode = Mode::new(common.tank.fundamental().omega, start.zeta);
         Ok(NonlinearAuto {
             nonlinear,
-            threshold,
-            linear,
+            linear: LinearBelow { threshold, mode },
         })
     }
 
@@ -77,10 +92,7 @@ impl Model for NonlinearAuto {
 
     #[inline(always)]
     fn step(&mut self, step: &Interval) -> Result<Stepped, StepError> {
-        let (threshold, linear) = (self.threshold, &mut self.linear);
-        self.nonlinear.step_or(step, |tld, y| {
-            linear_step(tld, (threshold, linear), y, step)
-        })
+        self.nonlinear.step_with(step, Some(&mut self.linear))
     }
 
     #[inline(always)]

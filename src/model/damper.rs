@@ -27,9 +27,11 @@ pub struct Damper {
     /// Damping ratio in use.
     zeta: f64,
     last_mean_force: Option<f64>,
-    /// Force of the liquid on the tanks at the current state [N], kept with the state: a master
-    /// reads it after every step, where it is a load.
+    /// Force of the liquid on the tanks [N] and the sloshing's displacement and velocity at the
+    /// current state, kept with the state: a master reads them after every step, where they are
+    /// loads.
     force: f64,
+    sloshing: (f64, f64),
 }
 
 impl Damper {
@@ -65,6 +67,7 @@ impl Damper {
             derived,
             initial_energy: model.observe(Observable::Stored),
             force: model.force(),
+            sloshing: model.sloshing(),
             model,
             tracker,
             amplitude,
@@ -109,9 +112,9 @@ impl Damper {
         Ok(stats)
     }
 
-    /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker. Out of
-    /// line: one copy for both kinds of amplitude.
-    #[inline(never)]
+    /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker. Small
+    /// (the models' steps are out of line), so inlined into both kinds of amplitude.
+    #[inline(always)]
     fn advance(
         &mut self,
         zeta: f64,
@@ -135,6 +138,7 @@ impl Damper {
         let inv_h = 1.0 / h;
         let stepped = self.model.step(&step)?;
         self.force = stepped.force;
+        self.sloshing = stepped.sloshing;
         // 1/h overflows for a subnormal h (and 0 x inf is NaN): over so short a step the mean
         // force is the force.
         let mean_force = stepped.impulse * inv_h;
@@ -159,8 +163,8 @@ impl Damper {
     #[inline(always)]
     pub fn per_step_output(&self, which: Output) -> Option<f64> {
         match which {
-            Output::X => Some(self.model.sloshing().0),
-            Output::V => Some(self.model.sloshing().1),
+            Output::X => Some(self.sloshing.0),
+            Output::V => Some(self.sloshing.1),
             Output::Force => Some(self.force),
             _ => None,
         }
@@ -250,6 +254,7 @@ impl Damper {
         damper.zeta = damper.common.zeta(damper.amplitude);
         damper.model.set_damping(damper.zeta);
         damper.force = damper.model.force();
+        damper.sloshing = damper.model.sloshing();
         Ok(damper)
     }
 }

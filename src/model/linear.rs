@@ -123,8 +123,9 @@ impl Model for Linear {
         self.sloshing_mass
     }
 
-    /// Exact propagation cannot fail; only the fundamental mode can run away (the higher ones
+    /// Out of line: the steps of the other models stay small. Exact propagation cannot fail; only the fundamental mode can run away (the higher ones
     /// respond less), so it is checked before anything changes.
+    #[inline(never)]
     fn step(&mut self, step: &Interval) -> Result<Stepped, StepError> {
         let (first, mut impulse) = self.modes[0].advanced(step);
         check_runaway(first.state.x, step.limit)?;
@@ -134,7 +135,7 @@ impl Model for Linear {
             *mode = next;
             impulse += i;
         }
-        Ok(Stepped::exact(impulse, self.force()))
+        Ok(Stepped::exact(impulse, self.force(), self.sloshing()))
     }
 
     #[inline(always)]

@@ -119,11 +119,13 @@ pub struct Stepped {
     pub impulse: f64,
     /// Force on the tanks at the step's end [N].
     pub force: f64,
+    /// [`Model::sloshing`] at the step's end.
+    pub sloshing: (f64, f64),
 }
 
 impl Stepped {
     /// A step taken by an exact solution: one step, no evaluations.
-    pub fn exact(impulse: f64, force: f64) -> Self {
+    pub fn exact(impulse: f64, force: f64, sloshing: (f64, f64)) -> Self {
         Stepped {
             stats: SolveStats {
                 accepted: 1,
@@ -131,6 +133,7 @@ impl Stepped {
             },
             impulse,
             force,
+            sloshing,
         }
     }
 }

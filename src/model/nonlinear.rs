@@ -254,6 +254,18 @@ impl RhsJob for Integration<'_> {
     }
 }
 
+/// A way to take a step of the nonlinear model without its integrator (model = Auto's exact
+/// linear step).
+pub trait Shortcut {
+    /// The state `y` of `tld` at the end of `step`, a runaway, or None: integrate.
+    fn step(
+        &mut self,
+        tld: &NonlinearTld,
+        y: &[f64; state::DIM],
+        step: &Interval,
+    ) -> Option<Result<[f64; state::DIM], StepError>>;
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Nonlinear {
     pub(super) tld: NonlinearTld,
@@ -267,15 +279,14 @@ pub struct Nonlinear {
 }
 
 impl Nonlinear {
-    /// [`Model::step`], taking `shortcut` where it offers the step's end.
-    #[inline(always)]
-    pub(super) fn step_or(
+    /// [`Model::step`], taking the `shortcut` where it offers the step's end. One function for
+    /// both nonlinear models: two copies of the integrators inlined for every kind of exponent
+    /// would make the cheapest steps dearer.
+    #[inline]
+    pub(super) fn step_with(
         &mut self,
         step: &Interval,
-        shortcut: impl FnOnce(
-            &NonlinearTld,
-            &[f64; state::DIM],
-        ) -> Option<Result<[f64; state::DIM], StepError>>,
+        shortcut: Option<&mut dyn Shortcut>,
     ) -> Result<Stepped, StepError> {
         // The model takes this step's damping and input in place (field by field: a whole-struct
         // copy here stalls on store forwarding) and gets its previous ones back if the step fails.
@@ -285,7 +296,7 @@ impl Nonlinear {
         self.tld.base.t0 = 0.0;
         self.tld.base.a = base.a;
         let v0 = self.y[state::V];
-        let outcome = match shortcut(&self.tld, &self.y) {
+        let outcome = match shortcut.and_then(|s| s.step(&self.tld, &self.y, step)) {
             Some(next) => next.map(|next| {
                 self.y = next;
                 let stats = SolveStats {
@@ -317,6 +328,7 @@ impl Nonlinear {
             stats,
             impulse,
             force: self.mass * force,
+            sloshing: (self.y[state::X], self.y[state::V]),
         })
     }
 }
@@ -352,7 +364,7 @@ impl Model for Nonlinear {
 
     #[inline(always)]
     fn step(&mut self, step: &Interval) -> Result<Stepped, StepError> {
-        self.step_or(step, |_, _| None)
+        self.step_with(step, None)
     }
 
     #[inline(always)]

@@ -81,6 +81,8 @@ impl Model for SloshingSlamming {
         self.sloshing_mass
     }
 
+    /// Out of line: the steps of the other models stay small.
+    #[inline(never)]
     fn step(&mut self, step: &Interval) -> Result<Stepped, StepError> {
         let (sloshing, slosh_impulse) = self.sloshing.advanced(step);
         check_runaway(sloshing.state.x, step.limit)?;
@@ -92,7 +94,7 @@ impl Model for SloshingSlamming {
         self.sloshing = sloshing;
         self.state = slam;
         let impulse = slosh_impulse + self.impact_mass * per_mass;
-        Ok(Stepped::exact(impulse, self.force()))
+        Ok(Stepped::exact(impulse, self.force(), self.sloshing()))
     }
 
     #[inline(always)]

@@ -179,6 +179,7 @@ fn the_force_kept_with_the_state_is_the_states_force() {
             assert_ne!(kept, 0.0, "{p:?}: a state with a force");
             // x and v: the (first) sloshing mode's, first in the snapshot.
             let snapshot = sim.snapshot();
+            assert_eq!(sim.sloshing, sim.model.sloshing(), "{p:?}, {when}");
             for (which, k) in [(Output::X, 0), (Output::V, 1)] {
                 let got = sim.output(which, &Inputs::default());
                 assert_eq!(got.to_bits(), snapshot[k].to_bits(), "{p:?} {which:?}");
