@@ -6,7 +6,9 @@ use std::ffi::CString;
 use super::logger::Logger;
 use super::params::{Source, Values, derived_value, free_real_input, output_of, source_of};
 use super::snapshot::Saved;
-use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, finite, index_of, vr};
+use super::vars::{
+    Causality, LOG_CATEGORIES, VARIABLES, VarType, Variability, Variable, finite, index_of, vr,
+};
 use crate::simulation::{Inputs, Output, Simulation, StepError};
 use crate::solver::SolveError;
 
@@ -100,8 +102,6 @@ impl Phase {
         }
     }
 }
-
-pub const LOG_CATEGORIES: [&str; 3] = ["logStatusError", "logStatusWarning", "logCalls"];
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Experiment {
