@@ -1,7 +1,7 @@
 //! Packs TLD.fmu: modelDescription.xml, binaries/linux64/TLD.so and documentation/index.html
 //! (prose from modelDescription/documentation.html, variable table from the generated table).
 //!
-//! Usage: tld-package <path to libtld_fmu.so> <output .fmu>
+//! Usage: tld-package <output .fmu> <library> [<library> ...]
 
 use std::io::Write;
 use std::path::Path;
