@@ -1,5 +1,12 @@
-//! The model description as Rust: the variable table that build.rs generates from
-//! modelDescription/modelDescription.xml, shared by the FMI layer and the models.
+//! The model description as Rust, shared by the FMI layer and the models: what build.rs
+//! generates from modelDescription/modelDescription.xml, and the types it uses:
+//! - `VARIABLES` (the variable table) and `vr::*` (value references, `.` becomes `_`);
+//! - one enum per enumeration type, named after it with `Item` appended (`ModelKindItem`,
+//!   `DampingLawItem`, `AmplitudeModeItem`, `SolverMethodItem`): the XML's items as variants with
+//!   their values as discriminants, `ALL`, `from_value`/`from_f64`/`TryFrom<i64>`, `value()`,
+//!   `name()`, `description()`;
+//! - `LOG_CATEGORIES` and `log_category::*` (one constant per category);
+//! - `limits::*`: the declared bounds (`limits::MODES_MAX` is the max of `modes`).
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VarType {

@@ -1,12 +1,12 @@
 //! Packs TLD.fmu: modelDescription.xml, binaries/linux64/TLD.so and documentation/index.html
 //! (prose from modelDescription/documentation.html, variable table from the generated table).
 //!
-//! Usage: tld-package <path to libtld_fmu.so> <output .fmu>
+//! Usage: tld-package <output .fmu> <library> [<library> ...]
 
 use std::io::Write;
 use std::path::Path;
 
-use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType};
+use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType, Variable};
 use zip::write::SimpleFileOptions;
 
 const XML: &str = include_str!("../../modelDescription/modelDescription.xml");
@@ -18,41 +18,62 @@ fn escape(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
+/// The columns of the variable table; [`cells`] fills them in this order.
+const COLUMNS: [&str; 9] = [
+    "name",
+    "value reference",
+    "causality",
+    "type",
+    "unit",
+    "start",
+    "min",
+    "max",
+    "description",
+];
+
+/// One variable's row of the table, escaped HTML, one entry per column of [`COLUMNS`].
+fn cells(v: &Variable) -> [String; COLUMNS.len()] {
+    let fmt = |x: Option<f64>| x.map(|x| format!("{x}")).unwrap_or_default();
+    let ty = match v.ty {
+        VarType::Enumeration => {
+            let items: Vec<String> = v
+                .items
+                .iter()
+                .map(|(n, val)| format!("{val} = {n}"))
+                .collect();
+            format!("Enumeration ({})", items.join(", "))
+        }
+        other => format!("{other:?}"),
+    };
+    let causality = match v.causality {
+        Causality::CalculatedParameter => "calculatedParameter".to_string(),
+        other => format!("{other:?}").to_lowercase(),
+    };
+    [
+        format!("<code>{}</code>", escape(v.name)),
+        v.vr.to_string(),
+        causality,
+        escape(&ty),
+        escape(v.unit),
+        fmt(v.start),
+        fmt(v.min),
+        fmt(v.max),
+        escape(v.description),
+    ]
+}
+
 /// The variables as an HTML table, with descriptions taken from the XML.
 fn variable_table() -> String {
-    let mut rows = String::new();
-    for v in VARIABLES {
-        let fmt = |x: Option<f64>| x.map(|x| format!("{x}")).unwrap_or_default();
-        let ty = match v.ty {
-            VarType::Enumeration => {
-                let items: Vec<String> = v
-                    .items
-                    .iter()
-                    .map(|(n, val)| format!("{val} = {n}"))
-                    .collect();
-                format!("Enumeration ({})", items.join(", "))
-            }
-            other => format!("{other:?}"),
-        };
-        let causality = match v.causality {
-            Causality::CalculatedParameter => "calculatedParameter".to_string(),
-            other => format!("{other:?}").to_lowercase(),
-        };
-        rows.push_str(&format!(
-            "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-            escape(v.name),
-            v.vr,
-            causality,
-            escape(&ty),
-            fmt(v.start),
-            fmt(v.min),
-            fmt(v.max),
-            escape(v.description)
-        ));
-    }
-    format!(
-        "<table>\n<tr><th>name</th><th>value reference</th><th>causality</th><th>type</th><th>unit</th><th>start</th><th>min</th><th>max</th><th>description</th></tr>\n{rows}</table>"
-    )
+    let row = |tag: &str, cells: &[String]| {
+        let cells: String = cells
+            .iter()
+            .map(|c| format!("<{tag}>{c}</{tag}>"))
+            .collect();
+        format!("<tr>{cells}</tr>\n")
+    };
+    let header = row("th", &COLUMNS.map(String::from));
+    let rows: String = VARIABLES.iter().map(|v| row("td", &cells(v))).collect();
+    format!("<table>\n{header}{rows}</table>")
 }
 
 fn main() {
@@ -113,4 +134,49 @@ fn pack(out: &Path, libraries: &[&Path]) -> Result<(), Box<dyn std::error::Error
     zip.finish()?;
     println!("wrote {}", out.display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The texts of the `<tag>` cells of each row of `html`.
+    fn table(html: &str, tag: &str) -> Vec<Vec<String>> {
+        let (open, close) = (format!("<{tag}>"), format!("</{tag}>"));
+        html.split("<tr>")
+            .skip(1)
+            .map(|row| {
+                row.split(&open)
+                    .skip(1)
+                    .map(|cell| cell.split(&close).next().unwrap_or("").to_string())
+                    .collect::<Vec<_>>()
+            })
+            .filter(|cells| !cells.is_empty())
+            .collect()
+    }
+
+    #[test]
+    fn every_row_fills_every_column_and_the_unit_column_holds_the_units() {
+        let html = variable_table();
+        let header = table(&html, "th");
+        assert_eq!(header.len(), 1);
+        let header = &header[0];
+        let rows = table(&html, "td");
+        assert_eq!(rows.len(), VARIABLES.len());
+        let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+        for (row, v) in rows.iter().zip(VARIABLES) {
+            assert_eq!(row.len(), header.len(), "{}: {row:?}", v.name);
+            assert_eq!(row[col("name")], format!("<code>{}</code>", v.name));
+            assert_eq!(row[col("value reference")], v.vr.to_string());
+            assert_eq!(row[col("unit")], v.unit, "{}", v.name);
+            assert_eq!(row[col("description")], escape(v.description), "{}", v.name);
+        }
+        let force = rows.iter().find(|r| r[0] == "<code>force</code>").unwrap();
+        assert_eq!(force[col("unit")], "N");
+    }
+
+    #[test]
+    fn the_documentation_gets_the_table() {
+        assert!(DOC.contains("{{VARIABLES}}"));
+    }
 }

@@ -8,7 +8,9 @@ use super::params::{
     Configuration, Source, Values, derived_value, free_real_input, output_of, source_of,
 };
 use super::snapshot::Saved;
-use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, finite, index_of, vr};
+use super::vars::{
+    Causality, LOG_CATEGORIES, VARIABLES, VarType, Variability, Variable, finite, index_of, vr,
+};
 use crate::model::{Damper, Inputs, Output, StepError};
 use crate::solver::SolveError;
 
@@ -102,8 +104,6 @@ impl Phase {
         }
     }
 }
-
-pub const LOG_CATEGORIES: [&str; 3] = ["logStatusError", "logStatusWarning", "logCalls"];
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Experiment {

@@ -2,6 +2,8 @@
 //! its call-sequence state machine, variable access and logging.
 
 mod exports;
+#[cfg(test)]
+mod generated_tests;
 mod instance;
 mod logger;
 mod params;

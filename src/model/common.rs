@@ -1,7 +1,7 @@
 //! The parameters every model shares: the tanks, the amplitude laws, the initial condition.
 
-use super::Parameters;
-use crate::description::vr;
+use super::{Parameters, choice};
+use crate::description::{AmplitudeModeItem, DampingLawItem, vr};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange};
 
@@ -38,28 +38,22 @@ pub struct Derived {
     pub mass_inactive: f64,
 }
 
-/// Items of the `damping` and `amplitude` enumerations (modelDescription.xml).
-const DAMPING_CONSTANT: i64 = 1;
-const AMPLITUDE_TRACKED: i64 = 2;
-
 impl Common {
     /// The shared parameters and the warnings they deserve; Err if they cannot be simulated.
     pub fn read(p: &dyn Parameters) -> Result<(Self, Vec<String>), String> {
-        let damping = if p.item(vr::DAMPING) == DAMPING_CONSTANT {
-            DampingLaw::Constant(p.value(vr::ZETA))
-        } else {
-            DampingLaw::Nsd {
+        let damping = match choice(p, vr::DAMPING)? {
+            DampingLawItem::Constant => DampingLaw::Constant(p.value(vr::ZETA)),
+            DampingLawItem::NSD => DampingLaw::Nsd {
                 c: p.value(vr::NSD_C),
                 p: p.value(vr::NSD_P),
-            }
+            },
         };
-        let amplitude = if p.item(vr::AMPLITUDE) == AMPLITUDE_TRACKED {
-            AmplitudeSource::Tracked {
+        let amplitude = match choice(p, vr::AMPLITUDE)? {
+            AmplitudeModeItem::Fixed => AmplitudeSource::Fixed(p.value(vr::A_E)),
+            AmplitudeModeItem::Tracked => AmplitudeSource::Tracked {
                 tau: p.value(vr::AMPLITUDE_TAU),
                 prior: p.value(vr::A_E),
-            }
-        } else {
-            AmplitudeSource::Fixed(p.value(vr::A_E))
+            },
         };
         let common = Common {
             tank: Tank {

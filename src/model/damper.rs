@@ -4,7 +4,7 @@
 
 use super::{
     AmplitudeSource, AnyModel, Common, Derived, Inputs, Interval, Observable, Output, Parameters,
-    Start, StepError,
+    Start, StepError, choice,
 };
 use crate::description::vr;
 use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
@@ -53,7 +53,8 @@ impl Damper {
             }
         };
         let zeta = common.zeta(amplitude);
-        let model = AnyModel::configure(p.item(vr::MODEL), p, &common, Start { zeta, amplitude })?;
+        let model =
+            AnyModel::configure(choice(p, vr::MODEL)?, p, &common, Start { zeta, amplitude })?;
         let mass_liquid = common.liquid_mass();
         let mass_slosh = model.sloshing_mass();
         let derived = Derived {

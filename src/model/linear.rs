@@ -4,7 +4,7 @@
 use super::check_runaway;
 use super::rates::{self, Oscillator};
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
-use crate::description::{VARIABLES, index_of, vr};
+use crate::description::{limits, vr};
 use crate::physics::linear::{Mode, ModeState};
 
 /// Numbers saved after the modes' states: the integrator memory of the state format, unused.
@@ -81,9 +81,7 @@ pub struct Linear {
 impl Model for Linear {
     fn configure(p: &dyn Parameters, common: &Common, start: Start) -> Result<Self, String> {
         let modes = p.count(vr::MODES);
-        let most = index_of(vr::MODES)
-            .and_then(|i| VARIABLES[i].max)
-            .unwrap_or(1.0) as u32;
+        let most = limits::MODES_MAX as u32;
         if !(1..=most).contains(&modes) {
             return Err(format!(
                 "modes = {modes}: the linear model carries 1 to {most} modes"

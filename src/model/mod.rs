@@ -16,7 +16,7 @@ pub mod slamming;
 
 pub use common::{AmplitudeSource, Common, Derived};
 pub use damper::Damper;
-pub use parameters::{Parameters, StartValues};
+pub use parameters::{Parameters, StartValues, choice};
 pub use registry::AnyModel;
 
 use crate::physics::base::BaseAcceleration;

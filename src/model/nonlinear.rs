@@ -3,8 +3,10 @@
 
 use super::check_runaway;
 use super::rates::{self, Oscillator};
-use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
-use crate::description::vr;
+use super::{
+    Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped, choice,
+};
+use crate::description::{SolverMethodItem, vr};
 use crate::physics::base::BaseAcceleration;
 use crate::physics::nonlinear::{CompiledTld, NonlinearTld, PowerLaw, RhsJob, state};
 use crate::solver::{
@@ -51,8 +53,8 @@ pub enum AdaptiveKind {
 }
 
 impl Method {
-    /// The method the `solver` parameters describe (items of the SolverMethod enumeration).
-    pub fn read(p: &dyn Parameters) -> Self {
+    /// The method the `solver` parameters describe.
+    pub fn read(p: &dyn Parameters) -> Result<Self, String> {
         let adaptive = |kind| Method::Adaptive {
             kind,
             rtol: p.value(vr::SOLVER_TOLERANCE),
@@ -62,16 +64,16 @@ impl Method {
             formula,
             step: p.value(vr::SOLVER_FIXED_STEP),
         };
-        match p.item(vr::SOLVER) {
-            2 => fixed(FixedFormula::Rk4),
-            3 => adaptive(AdaptiveKind::Sdirk4),
-            4 => adaptive(AdaptiveKind::StiffnessSwitching),
-            5 => adaptive(AdaptiveKind::DormandPrince853),
-            6 => fixed(FixedFormula::Rk5),
-            7 => fixed(FixedFormula::Rk8),
-            8 => fixed(FixedFormula::ExpRk4),
-            _ => adaptive(AdaptiveKind::DormandPrince),
-        }
+        Ok(match choice(p, vr::SOLVER)? {
+            SolverMethodItem::DormandPrince45 => adaptive(AdaptiveKind::DormandPrince),
+            SolverMethodItem::RK4 => fixed(FixedFormula::Rk4),
+            SolverMethodItem::SDIRK4 => adaptive(AdaptiveKind::Sdirk4),
+            SolverMethodItem::Auto => adaptive(AdaptiveKind::StiffnessSwitching),
+            SolverMethodItem::DormandPrince853 => adaptive(AdaptiveKind::DormandPrince853),
+            SolverMethodItem::RK5 => fixed(FixedFormula::Rk5),
+            SolverMethodItem::RK8 => fixed(FixedFormula::Rk8),
+            SolverMethodItem::ExpRK4 => fixed(FixedFormula::ExpRk4),
+        })
     }
 
     /// The relative tolerance the method works to (fixed steps: none; 1e-10 stands for it).
@@ -338,7 +340,7 @@ impl Model for Nonlinear {
         let fundamental = common.tank.fundamental();
         let omega_f = fundamental.omega;
         let length = common.tank.length;
-        let method = Method::read(p);
+        let method = Method::read(p)?;
         let tld = NonlinearTld {
             stiffness: PowerLaw::new(omega_f, p.value(vr::PHI), p.value(vr::ETA), length),
             c: 2.0 * start.zeta * omega_f,

@@ -3,6 +3,11 @@
 
 use crate::description::{VARIABLES, index_of};
 
+/// The name of the variable `vr`, for messages.
+fn name_of(vr: u32) -> &'static str {
+    index_of(vr).map_or("?", |i| VARIABLES[i].name)
+}
+
 /// Parameter values by value reference. Integer and enumeration values come as f64.
 pub trait Parameters {
     /// The value of the parameter `vr` (NaN if there is none).
@@ -17,6 +22,12 @@ pub trait Parameters {
     fn item(&self, vr: u32) -> i64 {
         self.value(vr) as i64
     }
+}
+
+/// The item of the enumeration `vr` that `p` holds, or the reason there is none.
+pub fn choice<T: TryFrom<i64>>(p: &dyn Parameters, vr: u32) -> Result<T, String> {
+    let value = p.item(vr);
+    T::try_from(value).map_err(|_| format!("{value} is no item of '{}'", name_of(vr)))
 }
 
 /// The model description's start values, with some values overridden.

@@ -2,9 +2,10 @@
 //! enumeration of modelDescription.xml. A new model is its module and one line here.
 
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
+use crate::description::ModelKindItem;
 
 macro_rules! registry {
-    ($( $item:literal => $variant:ident($model:ty) ),* $(,)?) => {
+    ($( $item:ident => $variant:ident($model:ty) ),* $(,)?) => {
         /// The model an instance runs, chosen by the `model` parameter. An enum rather than a
         /// trait object: every call dispatches by one match, which the compiler can inline.
         // One per instance: the size difference costs nothing, boxing would add an indirection
@@ -16,21 +17,23 @@ macro_rules! registry {
         }
 
         impl AnyModel {
-            /// The model of the `model` item `item`, configured.
+            /// The model of the `model` item `item`, configured. Every item must be here: an
+            /// item added to the XML and not registered does not compile.
             pub fn configure(
-                item: i64,
+                item: ModelKindItem,
                 p: &dyn Parameters,
                 common: &Common,
                 start: Start,
             ) -> Result<Self, String> {
                 match item {
-                    $( $item => <$model>::configure(p, common, start).map(AnyModel::$variant), )*
-                    other => Err(format!("model = {other} is no model of this FMU")),
+                    $( ModelKindItem::$item => {
+                        <$model>::configure(p, common, start).map(AnyModel::$variant)
+                    } )*
                 }
             }
 
-            /// The `model` items there are.
-            pub const ITEMS: &[i64] = &[$( $item ),*];
+            /// The registered `model` items.
+            pub const ITEMS: &[ModelKindItem] = &[$( ModelKindItem::$item ),*];
 
             #[inline(always)]
             pub fn sloshing_mass(&self) -> f64 {
@@ -83,8 +86,8 @@ macro_rules! registry {
 }
 
 registry! {
-    1 => Linear(super::linear::Linear),
-    2 => Nonlinear(super::nonlinear::Nonlinear),
-    3 => SloshingSlamming(super::slamming::SloshingSlamming),
-    4 => Auto(super::auto::NonlinearAuto),
+    Linear => Linear(super::linear::Linear),
+    Nonlinear => Nonlinear(super::nonlinear::Nonlinear),
+    SloshingSlamming => SloshingSlamming(super::slamming::SloshingSlamming),
+    Auto => Auto(super::auto::NonlinearAuto),
 }

@@ -75,7 +75,8 @@ def slave_factory(model_description, unzipdir, variables):
 
 
 # parameters that make the four models differ in the host-comparison scenes: the S^2 model's mass exchange
-# (Omega = 1 would make it the linear model until an impact), and an Auto threshold at which it
+# (set, not left to its default from the NSD law, so the scenes do not change with A_e or that law;
+# Omega = 1 would make it the linear model until an impact), and an Auto threshold at which it
 # steps linearly part of the time (at the default it matches Nonlinear to ~1e-14)
 MODELS_APART = {"slamming.Omega": 0.9, "auto.threshold": 1e-2}
 

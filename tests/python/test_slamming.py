@@ -99,3 +99,30 @@ def test_chattering_under_steady_push_ends_at_rest(slave_factory):
     n2 = s.fmu.getInteger([s.vr("impacts")])[0]
     assert 3 < n1 < 200 and n2 == n1, (n1, n2)
     assert out["impact.z"][-1] == pytest.approx(0.05)
+
+
+def nsd_kappa(lam):
+    """Frequency hardening ratio of the NSD fit (MODEL.md), written out here."""
+    return 1.075 * lam ** 0.007 if lam < 0.03 else 2.52 * lam ** 0.25
+
+
+def test_default_mass_exchange_follows_the_nsd_law(slave_factory):
+    """slamming.Omega left at its default (0): Omega = 1/kappa(Lambda)^2 at Lambda = A_e/a, so the
+    free sloshing mode (no base motion, so the impact mass stays at rest) runs at
+    omega_1 / sqrt(Omega) = kappa omega_1, about 4.6 % above omega_1 at the default A_e = 5 mm;
+    with Omega = 1 it would run at omega_1."""
+    p = R.TLD(damping=R.DAMPING_CONSTANT, zeta=0.0, x0=1e-3)
+    params = {**p.fmu_parameters(), "model": S2}
+    assert "slamming.Omega" not in params
+    s = slave_factory(quiet=True)
+    s.initialize(params)
+    dt, n = 0.01, 1000
+    out = s.run(dt, {"base.a": np.zeros(n)}, ["slosh.x"])
+    kappa = nsd_kappa(min(max(p.A_e / p.a, p.lambda_min), p.lambda_max))
+    assert kappa > 1.04
+    t = dt * np.arange(n + 1)
+    want = p.x0 * np.cos(kappa * p.omega_f * t)
+    err = np.max(np.abs(out["slosh.x"] - want))
+    print(f"\nkappa {kappa:.5f}, Omega {1 / kappa ** 2:.5f}: max error {err:.2e} m")
+    assert err < 1e-9, err
+    assert s.fmu.getInteger([s.vr("impacts")])[0] == 0

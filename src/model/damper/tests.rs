@@ -352,7 +352,7 @@ fn the_registry_holds_the_model_descriptions_models() {
         .find(|v| v.vr == vr::MODEL)
         .expect("a model parameter");
     let mut declared: Vec<i64> = model.items.iter().map(|(_, v)| *v).collect();
-    let mut registered = AnyModel::ITEMS.to_vec();
+    let mut registered: Vec<i64> = AnyModel::ITEMS.iter().map(|m| m.value()).collect();
     declared.sort();
     registered.sort();
     assert_eq!(declared, registered);
