@@ -42,8 +42,7 @@ import reference as R  # noqa: E402  (the independent reference, reused, not cop
 HERE = Path(__file__).resolve().parent
 WORK = REPO / "target" / "bench"
 CACHE = WORK / "cache"
-NATIVE_MANIFEST = REPO / "bench" / "native" / "Cargo.toml"
-NATIVE_BIN = REPO / "target" / "bench-native" / "release" / "tld-bench"
+NATIVE_BIN = REPO / "target" / "release" / "tld-bench"   # scripts/bench builds it (cargo -p tld-bench)
 
 TOLS = [1e-6, 1e-8, 1e-10, 1e-12]
 TOLS_HIGH_ORDER = [1e-13, 1e-14]

@@ -17,10 +17,20 @@ A = 0.003
 ZETA = 0.02
 
 
+def freqresp_exe():
+    """tld-freqresp (tools/), built or found up to date by cargo; its path from cargo's report."""
+    out = subprocess.run(["cargo", "build", "--quiet", "--bin", "tld-freqresp", "--message-format=json"],
+                         cwd=REPO, capture_output=True, text=True, check=True).stdout
+    for line in out.splitlines():
+        msg = json.loads(line)
+        if msg.get("reason") == "compiler-artifact" and msg.get("executable"):
+            return msg["executable"]
+    raise AssertionError(f"cargo built no tld-freqresp:\n{out}")
+
+
 def harmonic_balance():
-    exe = REPO / "target" / "debug" / "tld-freqresp"
-    assert exe.exists(), f"{exe} is not built (cargo build --bin tld-freqresp)"
-    out = subprocess.run([str(exe), "--eta", "2", "--phi", "1", "--zeta", str(ZETA), "--A", str(A),
+    exe = freqresp_exe()
+    out = subprocess.run([exe, "--eta", "2", "--phi", "1", "--zeta", str(ZETA), "--A", str(A),
                           "--json"], capture_output=True, text=True, check=True).stdout
     return json.loads(out)
 
