@@ -6,31 +6,19 @@ holds each frequency for 60 s (settling time 4.6 / (zeta w_f) = 41 s), keeps the
 base motion continuous, and measures the amplitude over the last 10 s of each hold."""
 import json
 import subprocess
-from pathlib import Path
 
 import numpy as np
 
-import reference as R
+from tld_fmu import reference as R
+from tld_fmu.paths import cargo_executable
 
-REPO = Path(__file__).resolve().parents[2]
 A = 0.003
 ZETA = 0.02
 
 
-def freqresp_exe():
-    """tld-freqresp (tools/), built or found up to date by cargo; its path from cargo's report."""
-    out = subprocess.run(["cargo", "build", "--quiet", "--bin", "tld-freqresp", "--message-format=json"],
-                         cwd=REPO, capture_output=True, text=True, check=True).stdout
-    for line in out.splitlines():
-        msg = json.loads(line)
-        if msg.get("reason") == "compiler-artifact" and msg.get("executable"):
-            return msg["executable"]
-    raise AssertionError(f"cargo built no tld-freqresp:\n{out}")
-
-
 def harmonic_balance():
-    exe = freqresp_exe()
-    out = subprocess.run([exe, "--eta", "2", "--phi", "1", "--zeta", str(ZETA), "--A", str(A),
+    exe = cargo_executable("tld-freqresp")   # tools/, built by cargo if missing or stale
+    out = subprocess.run([str(exe), "--eta", "2", "--phi", "1", "--zeta", str(ZETA), "--A", str(A),
                           "--json"], capture_output=True, text=True, check=True).stdout
     return json.loads(out)
 
