@@ -1,29 +1,26 @@
 """The seed's Fig. 2.5 experiment: the Table 2.1 structure (M = 168 kg, 0.32 %, 5.636 rad/s)
 with one 25 cm tank under harmonic ground motion; the structure's frequency response without the
 damper, and with the S^2 damper at Omega = 1.0 and Omega = 0.9, by co-simulation sweeps through
-TLD.fmu (the master of scripts/demo.py) and by the analysis tool (tld-freqresp --coupled: the
+TLD.fmu (the master of scripts/demo.py, tld_fmu.sdof) and by the analysis tool (tld-freqresp --coupled: the
 linear response with the impacts left out).
 
 Clearance d = 20 F0/k as in Table 2.1, with F0/k = A_g (the ground amplitude; F0 = M A_g w^2, k =
 M w_s^2, at resonance); e = 0.4; m2/m1 = 0.01; sloshing damping from the NSD law with the
 excitation amplitude tracked online. Writes docs/fig25.png and docs/fig25.md.
 
-Usage: .venv/bin/python scripts/fig25.py [--quick]   (after scripts/package and
-cargo build --release --bin tld-freqresp)"""
+Usage: .venv/bin/python scripts/fig25.py [--quick]   (after scripts/package; cargo builds
+tld-freqresp when it is missing)"""
 import argparse
 import json
 import math
 import multiprocessing as mp
 import subprocess
-import sys
 import tempfile
-from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
-import demo  # noqa: E402  (the co-simulation master)
+from tld_fmu import sdof as demo   # the co-simulation master of scripts/demo.py
+from tld_fmu.paths import FMU, REPO, cargo_executable
 
 A_G = 5e-4
 CLEARANCE = 20 * A_G
@@ -31,7 +28,8 @@ CLEARANCE = 20 * A_G
 
 # Sloshing damping: a lightly damped mode (constant 1 %), and the NSD law with the excitation
 # amplitude tracked online.
-DAMPINGS = {"constant zeta = 0.01": {"damping": 1, "zeta": 0.01}, "NSD law, tracked A_e": {"amplitude": 2}}
+DAMPINGS = {"constant zeta = 0.01": {"damping": "Constant", "zeta": 0.01},
+            "NSD law, tracked A_e": {"amplitude": "Tracked"}}
 
 
 COMPARISON = """## Against the seed's claims
@@ -59,7 +57,7 @@ amplitude. What this run shows (see the table for the numbers):
 
 def run(job):
     unzipdir, case, omega, ratio, duration = job
-    params = {"model": 3, "slamming.Omega": omega, "slamming.clearance": CLEARANCE,
+    params = {"model": "SloshingSlamming", "slamming.Omega": omega, "slamming.clearance": CLEARANCE,
               "slamming.restitution": 0.4, "slamming.mass_ratio": 0.01, **DAMPINGS[case]}
     r = demo.cosimulate(unzipdir, ratio * demo.W_S, A_G, 1e-3, duration, params=params)
     return case, omega, ratio, r["peak"] / A_G, r["A_e"]
@@ -73,11 +71,11 @@ def main():
     duration = 60.0 if args.quick else 150.0
     from fmpy import extract
     from tqdm import tqdm
-    unzipdir = extract(str(REPO / "target" / "fmu" / "TLD.fmu"), tempfile.mkdtemp())
+    unzipdir = extract(str(FMU), tempfile.mkdtemp())
     jobs = [(unzipdir, case, om, r, duration) for case in DAMPINGS for om in (1.0, 0.9) for r in ratios]
     with mp.Pool() as pool:
         results = list(tqdm(pool.imap(run, jobs), total=len(jobs), desc="co-simulation sweeps"))
-    exe = REPO / "target" / "release" / "tld-freqresp"
+    exe = cargo_executable("tld-freqresp", release=True)
 
     def analysis(om, zeta):
         out = subprocess.run([str(exe), "--coupled", "--Omega", str(om), "--zeta", str(zeta),

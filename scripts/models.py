@@ -1,35 +1,34 @@
 """Which model for which scene: error and cost of each model of the ladder on the benchmark's
-open-loop scenes (bench/python/bench.py), measured through the native host (bench/native).
+open-loop scenes (tld_fmu.scenes), measured through the native host (bench/native).
 
 Error: max |x - x_ref| / max |x_ref| over the whole history, x_ref the Nonlinear model's
-high-accuracy solution (tests/python/reference.py) with the same held inputs, so it measures
+high-accuracy solution (tld_fmu.reference) with the same held inputs, so it measures
 how far each model is from Eq 2.11 with the NSD-free scene physics. Cost: median ns per doStep.
 Writes docs/MODELS.md. Usage: scripts/bench builds what it needs; then
     .venv/bin/python scripts/models.py [--dt 0.01]"""
 import argparse
 import shutil
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(REPO / "bench" / "python"), str(REPO / "tests" / "python")]
-import bench  # noqa: E402
+from tld_fmu import scenes as bench
+from tld_fmu.paths import FMU, REPO
 
+# parameters per model (enumeration items by name; solver.fixed_step None: the communication step)
 MODELS = [
-    ("Linear, 1 mode", {"model": 1, "modes": 1}),
-    ("Linear, 3 modes", {"model": 1, "modes": 3}),
-    ("Nonlinear (defaults)", {"model": 2}),
-    ("Nonlinear, RK4 one substep", {"model": 2, "solver": 2, "solver.fixed_step": None}),
-    ("Nonlinear, ExpRK4 one substep", {"model": 2, "solver": 8, "solver.fixed_step": None}),
-    ("Nonlinear, RK8 one substep", {"model": 2, "solver": 7, "solver.fixed_step": None}),
-    ("Auto, threshold = tolerance", {"model": 4}),
-    ("Auto, threshold 1e-4", {"model": 4, "auto.threshold": 1e-4}),
-    ("Auto, threshold 1e-2", {"model": 4, "auto.threshold": 1e-2}),
-    ("SloshingSlamming, Omega 1", {"model": 3, "slamming.Omega": 1.0}),
+    ("Linear, 1 mode", {"model": "Linear", "modes": 1}),
+    ("Linear, 3 modes", {"model": "Linear", "modes": 3}),
+    ("Nonlinear (defaults)", {"model": "Nonlinear"}),
+    ("Nonlinear, RK4 one substep", {"model": "Nonlinear", "solver": "RK4", "solver.fixed_step": None}),
+    ("Nonlinear, ExpRK4 one substep", {"model": "Nonlinear", "solver": "ExpRK4", "solver.fixed_step": None}),
+    ("Nonlinear, RK8 one substep", {"model": "Nonlinear", "solver": "RK8", "solver.fixed_step": None}),
+    ("Auto, threshold = tolerance", {"model": "Auto"}),
+    ("Auto, threshold 1e-4", {"model": "Auto", "auto.threshold": 1e-4}),
+    ("Auto, threshold 1e-2", {"model": "Auto", "auto.threshold": 1e-2}),
+    ("SloshingSlamming, Omega 1", {"model": "SloshingSlamming", "slamming.Omega": 1.0}),
 ]
 
 
@@ -38,7 +37,7 @@ def main():
     ap.add_argument("--dt", type=float, default=0.01)
     args = ap.parse_args()
     dt = args.dt
-    fi = bench.FmuInfo(REPO / "target" / "fmu" / "TLD.fmu")
+    fi = bench.FmuInfo(FMU)
     scenes = [sc for sc in bench.make_scenes(False) if sc.kind == "open"]
     # A wind-level scene, where the hardening is small: the benchmark's scenes are all strongly
     # nonlinear (2x/a about 0.5).
@@ -59,9 +58,7 @@ def main():
         p = sc.p
         f = tmp / "input.f64"
         a.astype("<f8").tofile(f)
-        lines = [f"lib {fi.lib}", f"guid {fi.md.guid}",
-                 f"vrs base_a={fi.vr('base.a')} x={fi.vr('slosh.x')} v={fi.vr('slosh.v')} "
-                 f"force={fi.vr('force')} mass_inactive={fi.vr('mass.inactive')}",
+        lines = [f"lib {fi.lib}", f"guid {fi.md.guid}", fi.vrs_line(),
                  f"dt {dt!r}", f"repeats {3 if n > 1e5 else 5}", f"outdir {tmp}",
                  f"model omega={p.omega_f!r} zeta={p.zeta_fixed!r} eta={p.eta!r} phi={p.phi!r} a={p.a!r} m={p.m!r}",
                  f"input {f} {n}"]

@@ -35,58 +35,32 @@ impl log::Log for Capture {
     fn flush(&self) {}
 }
 
-/// The built library next to the test executable: target/<profile>/libtld_fmu.so.
+/// The cdylib built with this test: the library's crate types include cdylib, so cargo compiles
+/// the library this test links as rlib and cdylib in one rustc invocation and writes both into
+/// the directory of the test executable (target/<profile>/deps). A plain `cargo test` therefore
+/// builds what this host loads, from the same sources, in the same profile: nothing to build
+/// first, nothing stale.
 pub fn library_path() -> PathBuf {
     let exe = std::env::current_exe().expect("test executable path");
-    let dir = exe
-        .parent()
-        .and_then(|d| d.parent())
-        .expect("target/<profile>");
-    let path = dir.join("libtld_fmu.so");
-    let built = std::fs::metadata(&path)
-        .and_then(|m| m.modified())
-        .unwrap_or_else(|_| panic!("{} is not built: run `cargo build` first", path.display()));
-    // `cargo test` does not rebuild the cdylib: refuse to test a library older than its sources.
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    // The library is built from src/ (less src/bin) and modelDescription.xml (build.rs).
-    let xml = std::fs::metadata(root.join("modelDescription/modelDescription.xml"))
-        .and_then(|m| m.modified());
-    let newest =
-        newest_source(&root.join("src")).max(xml.unwrap_or(std::time::SystemTime::UNIX_EPOCH));
+    let name = format!(
+        "{}tld_fmu{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    );
+    let path = exe.parent().expect("target/<profile>/deps").join(name);
     assert!(
-        built >= newest,
-        "{} is older than the sources: run `cargo build` first",
+        path.is_file(),
+        "{} is missing: cargo builds it with the test (crate-type cdylib in Cargo.toml)",
         path.display()
     );
     path
-}
-
-fn newest_source(dir: &std::path::Path) -> std::time::SystemTime {
-    let mut newest = std::time::SystemTime::UNIX_EPOCH;
-    for entry in std::fs::read_dir(dir).into_iter().flatten().flatten() {
-        let p = entry.path();
-        // The command-line tools in src/bin are not part of the library.
-        if p.ends_with("bin") {
-            continue;
-        }
-        let t = if p.is_dir() {
-            newest_source(&p)
-        } else {
-            entry
-                .metadata()
-                .and_then(|m| m.modified())
-                .unwrap_or(newest)
-        };
-        newest = newest.max(t);
-    }
-    newest
 }
 
 pub fn library() -> &'static Fmi2Binding {
     static LIB: OnceLock<Fmi2Binding> = OnceLock::new();
     LIB.get_or_init(|| {
         let _ = log::set_logger(&Capture).map(|()| log::set_max_level(log::LevelFilter::Trace));
-        // SAFETY: loading our own library, built by this cargo invocation.
+        // SAFETY: loading our own library, built with this test by cargo.
         unsafe { Fmi2Binding::new(library_path()) }.expect("load libtld_fmu.so")
     })
 }

@@ -4,24 +4,18 @@ The FMU is expected at <repo>/target/fmu/TLD.fmu (built by the Rust side). If it
 every test that needs it FAILS (not skips) with a message saying so; the tests of the reference
 solutions (test_reference.py) still run.
 
-`Slave` drives one FMU instance through fmpy's low-level FMU2Slave API, captures the FMU's log
-messages through a logger callback, and runs long fixed-step co-simulations with the raw ctypes
-entry points (no per-call Python conversions), so 60 000 steps take well under a second.
+`Slave` (tld_fmu.slave) drives one FMU instance through fmpy's low-level FMU2Slave API.
 """
 from __future__ import annotations
 
-import ctypes
-import os
 import shutil
 import tempfile
 from pathlib import Path
 
-import numpy as np
 import pytest
 
-REPO = Path(__file__).resolve().parents[2]
-# the build's output; TLD_FMU_PATH overrides it (to test another build of the FMU)
-FMU_PATH = Path(os.environ.get("TLD_FMU_PATH") or REPO / "target" / "fmu" / "TLD.fmu")
+from tld_fmu.paths import FMU as FMU_PATH   # the build's output; TLD_FMU_PATH overrides it
+from tld_fmu.slave import Slave
 
 
 def _require_fmu() -> Path:
@@ -79,173 +73,3 @@ def slave_factory(model_description, unzipdir, variables):
 # Omega = 1 would make it the linear model until an impact), and an Auto threshold at which it
 # steps linearly part of the time (at the default it matches Nonlinear to ~1e-14)
 MODELS_APART = {"slamming.Omega": 0.9, "auto.threshold": 1e-2}
-
-
-_LOGGER = None                                   # the one logger fmpy's proxy calls (see Slave)
-_LOG_ROUTES: dict[int, list] = {}                # componentEnvironment -> that Slave's messages
-
-
-def _route_log_message(env, instance, status, category, message):
-    try:
-        messages = _LOG_ROUTES.get(env or 0)
-        if messages is not None:
-            messages.append((int(status), (category or b"").decode("utf-8", "replace"),
-                             (message or b"").decode("utf-8", "replace")))
-    except Exception:  # never let an exception unwind into the FMU
-        pass
-
-
-class Slave:
-    """One FMU instance driven through fmpy.fmi2.FMU2Slave."""
-
-    def __init__(self, md, unzipdir, variables, name="tld", logging_on=True, quiet=False):
-        """logging_on: fmi2Instantiate's loggingOn. quiet: restrict the debug log to the
-        status categories (no per-call logging), for long runs."""
-        from fmpy.fmi2 import (FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
-                               fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE)
-        from fmpy import calloc, free
-        from fmpy.logging import addLoggerProxy
-
-        self.vars = variables
-        self.messages: list[tuple[int, str, str]] = []   # (status, category, message)
-
-        # fmpy's printf-formatting proxy (logging.so) keeps ONE global Python target for every
-        # instance in the process, whatever struct it was installed into: a per-instance Python
-        # logger would dangle there once its Slave is gone, and the next FMU that logs through
-        # fmpy's proxy (any FMU2Slave with the default callbacks) would crash the process. So the
-        # target is one module-level router that lives forever and dispatches on
-        # componentEnvironment.
-        global _LOGGER
-        if _LOGGER is None:
-            _LOGGER = fmi2CallbackLoggerTYPE(_route_log_message)
-        key = len(_LOG_ROUTES) + 1
-        _LOG_ROUTES[key] = self.messages
-        cb = fmi2CallbackFunctions()
-        cb.logger = _LOGGER
-        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        cb.componentEnvironment = key
-        addLoggerProxy(ctypes.byref(cb))   # the proxy in front of the router
-        self._callbacks = cb              # keep alive as long as the instance
-        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
-                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
-        self.fmu.instantiate(callbacks=cb, loggingOn=logging_on)
-        if quiet and logging_on:
-            cats = [c.name for c in md.logCategories if c.name.startswith("logStatus")]
-            if cats:
-                arr = (ctypes.c_char_p * len(cats))(*[c.encode() for c in cats])
-                self.fmu.fmi2SetDebugLogging(self.fmu.component, 1, len(cats), arr)
-        self.time = 0.0
-        self._closed = False
-
-    # -- variable access by name ----------------------------------------------------------------
-    def vr(self, name):
-        return self.vars[name].valueReference
-
-    def set_vars(self, values: dict):
-        for name, value in values.items():
-            v = self.vars[name]
-            if v.type == "Real":
-                self.fmu.setReal([v.valueReference], [float(value)])
-            elif v.type in ("Integer", "Enumeration"):
-                self.fmu.setInteger([v.valueReference], [int(value)])
-            elif v.type == "Boolean":
-                self.fmu.setBoolean([v.valueReference], [bool(value)])
-            else:
-                raise TypeError(f"{name}: type {v.type}")
-
-    def get(self, *names):
-        out = []
-        for name in names:
-            v = self.vars[name]
-            if v.type == "Real":
-                out.append(self.fmu.getReal([v.valueReference])[0])
-            else:
-                out.append(self.fmu.getInteger([v.valueReference])[0])
-        return out if len(out) > 1 else out[0]
-
-    # -- life cycle -------------------------------------------------------------------------------
-    def initialize(self, params: dict | None = None, tolerance=None, start=0.0):
-        self.fmu.setupExperiment(tolerance=tolerance, startTime=start)
-        if params:
-            self.set_vars(params)
-        self.fmu.enterInitializationMode()
-        self.fmu.exitInitializationMode()
-        self.time = start
-        return self
-
-    def close(self):
-        if self._closed:
-            return
-        self._closed = True
-        from fmpy.fmi1 import FMICallException
-        try:
-            self.fmu.terminate()
-        except FMICallException:
-            pass
-        self.fmu.freeInstance()
-
-    # -- fast fixed-step run --------------------------------------------------------------------------
-    def run(self, dt, inputs: dict, outputs, n_steps=None, derivatives: dict | None = None):
-        """Co-simulate n steps of length dt. inputs: {name: array of length n} set before step k
-        (held during it, unless derivatives are given). derivatives: {(name, order): array of
-        length n} passed with fmi2SetRealInputDerivatives before step k. Returns {name: array of
-        length n+1} for outputs, sampled at the start (index 0) and after every step, BEFORE the
-        next inputs are set."""
-        try:
-            return self._run(dt, inputs, outputs, n_steps, derivatives or {})
-        except Exception as e:
-            tail = "\n".join(f"  [{st}] {cat}: {msg}" for st, cat, msg in self.messages[-5:])
-            raise AssertionError(f"{e}\nlast FMU log messages:\n{tail or '  (none)'}") from e
-
-    def _run(self, dt, inputs, outputs, n_steps, derivatives):
-        from fmpy.fmi1 import FMICallException
-        f = self.fmu._functions
-        setReal, getReal, doStep = f["fmi2SetReal"], f["fmi2GetReal"], f["fmi2DoStep"]
-        setDer = f["fmi2SetRealInputDerivatives"]
-        nd = len(derivatives)
-        d_vr = (ctypes.c_uint * max(nd, 1))(*[self.vr(k[0]) for k in derivatives])
-        d_order = (ctypes.c_int * max(nd, 1))(*[k[1] for k in derivatives])
-        d_val = (ctypes.c_double * max(nd, 1))()
-        d_rows = [np.asarray(a, float) for a in derivatives.values()]
-        comp = self.fmu.component
-        in_names = list(inputs)
-        n = n_steps if n_steps is not None else len(next(iter(inputs.values())))
-        rows = (np.column_stack([np.asarray(inputs[k], float)[:n] for k in in_names]).tolist()
-                if in_names else [[]] * n)
-        nin, nout = len(in_names), len(outputs)
-        in_vr = (ctypes.c_uint * max(nin, 1))(*[self.vr(k) for k in in_names])
-        in_val = (ctypes.c_double * max(nin, 1))()
-        out_vr = (ctypes.c_uint * nout)(*[self.vr(k) for k in outputs])
-        out_val = (ctypes.c_double * nout)()
-        res = np.empty((n + 1, nout))
-        st = getReal(comp, out_vr, nout, out_val)
-        if st > 1:
-            raise FMICallException("fmi2GetReal", st)
-        res[0] = out_val[:]
-        t0 = self.time
-        for k in range(n):
-            if nin:
-                in_val[:nin] = rows[k]
-                st = setReal(comp, in_vr, nin, in_val)
-                if st > 1:
-                    raise FMICallException("fmi2SetReal", st)
-            if nd:
-                d_val[:nd] = [float(a[k]) for a in d_rows]
-                st = setDer(comp, d_vr, nd, d_order, d_val)
-                if st > 1:
-                    raise FMICallException("fmi2SetRealInputDerivatives", st)
-            st = doStep(comp, t0 + k * dt, dt, 1)
-            if st > 1:
-                raise FMICallException(f"fmi2DoStep (step {k}, t = {t0 + k * dt})", st)
-            st = getReal(comp, out_vr, nout, out_val)
-            if st > 1:
-                raise FMICallException("fmi2GetReal", st)
-            res[k + 1] = out_val[:]
-        self.time = t0 + n * dt
-        return {name: res[:, i] for i, name in enumerate(outputs)}
-
-    def error_messages(self, since=0):
-        """Messages logged with status fmi2Discard or worse, from index `since` on."""
-        return [m for m in self.messages[since:] if m[0] >= 2]
-

@@ -1,4 +1,4 @@
-"""scripts/building.py against the monolithic solution of the same coupled equations (issue:
+"""scripts/building.py (tld_fmu.building) against the monolithic solution of the same coupled equations (issue:
 'a comparison with the monolithic solution of the same coupled equations for the linear case
 (error order vs communication step)'). With model = Linear (one mode) the building + dampers are
 one linear system, integrated here by scipy's DOP853 at rtol 1e-11:
@@ -9,18 +9,15 @@ one linear system, integrated here by scipy's DOP853 at rtol 1e-11:
 The co-simulation holds each damper's force over a step (force.mean after the first): first
 order in the communication step."""
 import math
-import sys
 import tempfile
 import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-REPO = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(REPO / "scripts"))
-import building  # noqa: E402
+from tld_fmu import building
+from tld_fmu.paths import REPO
 
 CFG = tomllib.loads((REPO / "scripts" / "examples" / "building.toml").read_text())
 ZETA = 0.02
@@ -34,7 +31,7 @@ def test_cosimulation_converges_to_the_monolithic_solution(fmu_path, model_descr
     wind loading takes), here a smooth known function so that the monolithic solver sees the
     same load at every instant. held: first order; derivatives (force rates out, base.a rates
     in): second order."""
-    cfg = {**CFG, "dampers": [{**d, "params": {"model": 1, "modes": 1, "damping": 1, "zeta": ZETA}}
+    cfg = {**CFG, "dampers": [{**d, "params": {"model": "Linear", "modes": 1, "damping": "Constant", "zeta": ZETA}}
                               for d in CFG["dampers"]]}
     b = cfg["building"]
     w = 0.97 * building.Building(b["masses"], b["stiffnesses"], b["rayleigh"]).omega1
@@ -163,7 +160,7 @@ def test_pooled_instances_forget_the_previous_runs_parameters(model_description,
     one before must match a fresh instance (the earlier values must not leak)."""
     b = {"building": CFG["building"]}
     a = lambda t: (-2e-3 * math.sin(5.6 * t), 2e-3 / 5.6 * math.cos(5.6 * t), 2e-3 / 31.36 * math.sin(5.6 * t))  # noqa: E731
-    heavy = {**b, "dampers": [{"floor": 3, "tanks": 3, "params": {"damping": 1, "zeta": 0.2, "tank.depth": 0.03}}]}
+    heavy = {**b, "dampers": [{"floor": 3, "tanks": 3, "params": {"damping": "Constant", "zeta": 0.2, "tank.depth": 0.03}}]}
     plain = {**b, "dampers": [{"floor": 3}]}
     pool = building.DamperPool(unzipdir, model_description)
     try:

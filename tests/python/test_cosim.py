@@ -1,27 +1,15 @@
 """Co-simulation of the seed's Table 2.1 structure with TLD.fmu (VERIFY.md 7), using the master
-algorithm of scripts/demo.py itself: it must approach the monolithic solution of the same coupled
+algorithm of scripts/demo.py itself (tld_fmu.sdof): it must approach the monolithic solution of the same coupled
 equations as the communication step shrinks, at first order with inputs held over each step and
 at second order when the master exchanges derivatives (output derivative of `force`, input
 derivative of base.a): the order the input handling promises."""
-import importlib.util
-import math
-
 import numpy as np
-import pytest
 
-import reference as R
-from conftest import REPO
-
-
-def load_demo():
-    spec = importlib.util.spec_from_file_location("tld_demo", REPO / "scripts" / "demo.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+from tld_fmu import reference as R
+from tld_fmu import sdof as demo
 
 
 def test_cosimulation_converges_to_monolithic(unzipdir):
-    demo = load_demo()
     # Fixed amplitude (design A_e = 2 mm, about the response near resonance) so that the
     # monolithic reference has the same constant damping ratio; ground motion at resonance
     p = R.TLD(A_e=0.002)
@@ -50,7 +38,6 @@ def test_cosimulation_with_derivatives_converges_at_second_order(unzipdir):
     d(force)/dt through fmi2GetRealOutputDerivatives and hands the FMU d(base.a)/dt through
     fmi2SetRealInputDerivatives; halving the step must quarter the error against the monolithic
     solution, and the error must be far below the held-input master's."""
-    demo = load_demo()
     p = R.TLD(A_e=0.002)
     w, A_g, t_end = demo.W_S, 1e-4, 20.0
     errs, held = {}, {}

@@ -35,6 +35,7 @@ from libcosimpy.CosimSlave import CosimLocalSlave
 from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 
 from conftest import MODELS_APART
+from tld_fmu.contract import item
 from host_scene import DT, N, OUTPUTS, RTOL, T_END, base_acceleration, compare, rel_diff, run_fmpy
 
 log_output_level(CosimLogLevel.WARNING)   # libcosim traces every FMI call otherwise
@@ -82,7 +83,7 @@ def test_libcosim_cannot_set_enumerations(fmu_path, variables):
     i = ex.add_local_slave(slave)
     exposed = {v.reference for v in ex.slave_variables(i)}
     assert variables["damping"].valueReference not in exposed
-    assert not ex.integer_initial_value(i, variables["damping"].valueReference, 1)
+    assert not ex.integer_initial_value(i, variables["damping"].valueReference, item("damping", "Constant"))
     # the Real and plain Integer parameters are there
     assert {variables["zeta"].valueReference, variables["tanks"].valueReference} <= exposed
     del ex
@@ -152,16 +153,18 @@ def test_comparison_detects_a_different_input(fmu_path, variables, slave_factory
 
 
 
-@pytest.mark.parametrize("model", [1, 2, 3, 4], ids=["Linear", "Nonlinear", "SloshingSlamming", "Auto"])
+@pytest.mark.parametrize("model", ["Linear", "Nonlinear", "SloshingSlamming", "Auto"])
 def test_every_option_reachable_from_libcosim_through_the_integer_aliases(fmu_path, variables, slave_factory, model):
     """FMU.md: every option must be reachable from libcosim, which cannot set Enumeration
-    variables. The plain Integer aliases model_id and damping_id carry them: libcosim with
-    model_id = m, damping_id = 1 (Constant) must match fmpy setting the enumerations
-    themselves (model = m, damping = 1)."""
+    variables. The plain Integer aliases model_id and damping_id carry them (the enumerations'
+    values): libcosim with model_id = m, damping_id = Constant must match fmpy setting the
+    enumerations themselves (model = m, damping = Constant)."""
     a = base_acceleration()
     reals = {**SCENE_REALS, **MODELS_APART}
-    fm = {m: run_fmpy(slave_factory, a, reals, {"model": m, "damping": 1}) for m in (1, 2, 3, 4)}
-    lc = run_libcosim(fmu_path, variables, a, reals, {"model_id": model, "damping_id": 1})
+    models = ["Linear", "Nonlinear", "SloshingSlamming", "Auto"]
+    fm = {m: run_fmpy(slave_factory, a, reals, {"model": m, "damping": "Constant"}) for m in models}
+    lc = run_libcosim(fmu_path, variables, a, reals,
+                      {"model_id": item("model", model), "damping_id": item("damping", "Constant")})
     d = compare(lc, fm[model])
     for n in OUTPUTS:
         assert d[n] < RTOL, f"model {model}, {n}: libcosim and fmpy differ by {d[n]:.3g}"

@@ -66,6 +66,7 @@ import numpy as np
 import pytest
 
 from conftest import MODELS_APART
+from tld_fmu.contract import item, items
 from host_scene import (
     DT, N, OUTPUTS, RTOL, T_END, base_acceleration, bitwise, compare, rel_diff, run_fmpy,
 )
@@ -280,10 +281,11 @@ def test_ecos_cannot_set_enumerations(fmu_path):
     try:
         for name in ("model", "damping", "amplitude", "solver"):
             with pytest.raises(Exception, match="No int property"):
-                sim.set_integer(f"{INSTANCE}::{name}", 1)
+                sim.set_integer(f"{INSTANCE}::{name}", items(name)[0][1])
             with pytest.raises(Exception, match="No int property"):
                 sim.get_integer(f"{INSTANCE}::{name}")
         assert sim.init()
+        # the aliases start at 0 ("use the enumeration"), not at an item
         assert [sim.get_integer(f"{INSTANCE}::{n}") for n in ("model_id", "damping_id", "tanks")] == [0, 0, 1]
         sim.terminate()
     finally:
@@ -292,19 +294,22 @@ def test_ecos_cannot_set_enumerations(fmu_path):
 
 
 DISTINCT = {"zeta": 0.02, **MODELS_APART}
+MODELS = ["Linear", "Nonlinear", "SloshingSlamming", "Auto"]   # items of `model`
 
 
-@pytest.mark.parametrize("model", [1, 2, 3, 4], ids=["Linear", "Nonlinear", "SloshingSlamming", "Auto"])
+@pytest.mark.parametrize("model", MODELS)
 def test_every_option_reachable_from_ecos_through_the_integer_aliases(fmu_path, slave_factory, model):
-    """Ecos with model_id = m, damping_id = 1 (Constant), zeta = 0.02 (set_integer/set_real
-    before init) matches fmpy setting the enumerations themselves (model = m, damping = 1)."""
+    """Ecos with model_id = m, damping_id = Constant's value, zeta = 0.02 (set_integer/set_real
+    before init) matches fmpy setting the enumerations themselves (model = m, damping = Constant);
+    the aliases take the enumerations' values."""
     a = base_acceleration()
-    fm = {m: run_fmpy(slave_factory, a, {"model": m, "damping": 1, **DISTINCT}) for m in (1, 2, 3, 4)}
-    ec, _, _, back = run_ecos(fmu_path, a, DISTINCT, {"model_id": model, "damping_id": 1},
+    fm = {m: run_fmpy(slave_factory, a, {"model": m, "damping": "Constant", **DISTINCT}) for m in MODELS}
+    aliases = {"model_id": item("model", model), "damping_id": item("damping", "Constant")}
+    ec, _, _, back = run_ecos(fmu_path, a, DISTINCT, aliases,
                               via="setters", readback=["model_id", "damping_id", "zeta"])
-    assert back == {"model_id": model, "damping_id": 1, "zeta": 0.02}, back
+    assert back == {**aliases, "zeta": 0.02}, back
     d = compare(ec, fm[model])
-    print(f"\nmodel_id = {model}, damping_id = 1: ecos vs fmpy {d}")
+    print(f"\n{aliases}: ecos vs fmpy {d}")
     for n in OUTPUTS:
         assert d[n] < RTOL, f"model {model}, {n}: ecos and fmpy differ by {d[n]:.3g}"
     # the option took effect: Ecos's run is told apart from every other model's

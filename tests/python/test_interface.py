@@ -2,7 +2,7 @@
 enumeration integer values, model structure, and the calculated parameters (Eqs 2.1/2.2)."""
 import pytest
 
-import reference as R
+from tld_fmu import reference as R
 
 # FMU.md, "Variables": the public interface (name -> causality)
 FMU_MD_VARIABLES = {

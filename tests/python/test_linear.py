@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-import reference as R
+from tld_fmu import reference as R
 
 ZETA = 0.02
 LINEAR = R.TLD(eta=1.0, phi=0.0, damping=R.DAMPING_CONSTANT, zeta=ZETA)

@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-import reference as R
+from tld_fmu import reference as R
+from tld_fmu.contract import item
 
 ZETA = 0.02
-LINEAR = 1  # the `model` enumeration's value for Linear
+LINEAR = item("model", "Linear")
 
 
 def run(slave_factory, dt, a, modes, outputs, extra=None):

@@ -8,8 +8,8 @@ converged to ~1e-14 (test_reference.py)."""
 import numpy as np
 import pytest
 
-import reference as R
-from conftest import Slave
+from tld_fmu import reference as R
+from tld_fmu.slave import Slave
 
 T_END = 60.0
 OUTPUTS = ["slosh.x", "slosh.v", "force", "force.mean", "base_shear", "energy.input",

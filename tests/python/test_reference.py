@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-import reference as R
+from tld_fmu import reference as R
 
 
 def test_geometry_check_values_of_model_md():

@@ -13,7 +13,8 @@ import textwrap
 import numpy as np
 import pytest
 
-import reference as R
+from tld_fmu import reference as R
+from tld_fmu.contract import items
 
 DT, N = 1e-3, 300
 P = R.TLD()
@@ -35,6 +36,9 @@ def _do_step(s, t, h):
     return lambda: s.fmu.fmi2DoStep(s.fmu.component, t, h, 1)
 
 
+# a value the `damping` enumeration does not have
+NO_DAMPING_ITEM = 1 + max(value for _, value, _ in items("damping"))
+
 # (id, phase, action(s) -> callable performing the bad call)
 #   phase: "instantiated" (before fmi2SetupExperiment), "after_init" (right after
 #   fmi2ExitInitializationMode), "mid_run" (after half of the steps)
@@ -45,7 +49,8 @@ CASES = [
     ("zeta = NaN", "instantiated", lambda s: lambda: s.set_vars({"zeta": math.nan})),
     ("phi = +Inf", "instantiated", lambda s: lambda: s.set_vars({"phi": math.inf})),
     ("tanks = 0", "instantiated", lambda s: lambda: s.set_vars({"tanks": 0})),
-    ("damping = 7 (no such item)", "instantiated", lambda s: lambda: s.set_vars({"damping": 7})),
+    (f"damping = {NO_DAMPING_ITEM} (no such item)", "instantiated",
+     lambda s: lambda: s.set_vars({"damping": NO_DAMPING_ITEM})),
     ("exitInitializationMode twice", "after_init", lambda s: s.fmu.exitInitializationMode),
     ("setReal fixed parameter after init", "after_init",
      lambda s: lambda: s.set_vars({"tank.length": 0.3})),
@@ -66,7 +71,7 @@ CASES = [
 
 @pytest.fixture(scope="module")
 def untouched(model_description, unzipdir, variables):
-    from conftest import Slave
+    from tld_fmu.slave import Slave
     s = Slave(model_description, unzipdir, variables, name="untouched")
     try:
         s.initialize()

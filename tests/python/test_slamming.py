@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-import reference as R
+from tld_fmu import reference as R
 
 S2 = 3
 E, D, RATIO = 0.4, 0.1, 0.01

@@ -6,13 +6,12 @@ import textwrap
 
 import numpy as np
 
-import reference as R
+from tld_fmu import reference as R
 
 # The child process: load the FMU, restore the state from a file, continue, print the results.
 CHILD = textwrap.dedent("""
-    import sys, numpy as np
-    sys.path.insert(0, {tests!r})
-    from conftest import Slave
+    import numpy as np
+    from tld_fmu.slave import Slave
     from fmpy import read_model_description, extract
     md = read_model_description({fmu!r})
     variables = {{v.name: v for v in md.modelVariables}}
@@ -35,7 +34,7 @@ def test_state_restores_in_another_process(slave_factory, fmu_path, tmp_path):
     t = dt * np.arange(n1 + n2)
     a = -w * w * 0.004 * np.sin(w * t)
     s = slave_factory(quiet=True)
-    s.initialize({**p.fmu_parameters(), "amplitude": 2})
+    s.initialize({**p.fmu_parameters(), "amplitude": "Tracked"})
     s.run(dt, {"base.a": a[:n1]}, ["slosh.x"])
     state = s.fmu.getFMUstate()
     (tmp_path / "state.bin").write_bytes(s.fmu.serializeFMUstate(state))
@@ -45,7 +44,7 @@ def test_state_restores_in_another_process(slave_factory, fmu_path, tmp_path):
     out = s.run(dt, {"base.a": a[n1:]}, names)
     uninterrupted = np.column_stack([out[k] for k in names])
     np.save(tmp_path / "inputs.npy", a[n1:])
-    code = CHILD.format(tests=str(R.__file__).rsplit("/", 1)[0], fmu=str(fmu_path),
+    code = CHILD.format(fmu=str(fmu_path),
                         state=str(tmp_path / "state.bin"), t=t_saved, inputs=str(tmp_path / "inputs.npy"),
                         dt=dt, result=str(tmp_path / "result.npy"))
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)

@@ -6,20 +6,18 @@ holds each frequency for 60 s (settling time 4.6 / (zeta w_f) = 41 s), keeps the
 base motion continuous, and measures the amplitude over the last 10 s of each hold."""
 import json
 import subprocess
-from pathlib import Path
 
 import numpy as np
 
-import reference as R
+from tld_fmu import reference as R
+from tld_fmu.paths import cargo_executable
 
-REPO = Path(__file__).resolve().parents[2]
 A = 0.003
 ZETA = 0.02
 
 
 def harmonic_balance():
-    exe = REPO / "target" / "debug" / "tld-freqresp"
-    assert exe.exists(), f"{exe} is not built (cargo build --bin tld-freqresp)"
+    exe = cargo_executable("tld-freqresp")   # tools/, built by cargo if missing or stale
     out = subprocess.run([str(exe), "--eta", "2", "--phi", "1", "--zeta", str(ZETA), "--A", str(A),
                           "--json"], capture_output=True, text=True, check=True).stdout
     return json.loads(out)

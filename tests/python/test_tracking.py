@@ -10,7 +10,7 @@ more."""
 import numpy as np
 import pytest
 
-import reference as R
+from tld_fmu import reference as R
 
 A = 0.005
 T_END, T_SETTLED, DT = 60.0, 40.0, 1e-3

@@ -26,7 +26,11 @@ pub struct Model {
 impl Model {
     pub fn new(omega: f64, zeta: f64, eta: f64, phi: f64, a: f64, m: f64) -> Self {
         let p = 2.0 * eta - 2.0;
-        let p_int = if p.fract() == 0.0 && p.abs() <= 64.0 { Some(p as i32) } else { None };
+        let p_int = if p.fract() == 0.0 && p.abs() <= 64.0 {
+            Some(p as i32)
+        } else {
+            None
+        };
         Model {
             w2: omega * omega,
             c: 2.0 * zeta * omega,
@@ -134,7 +138,11 @@ const E7: f64 = -1.0 / 40.0;
 
 impl Dp45 {
     pub fn new(rtol: f64) -> Self {
-        Dp45 { rtol, h: 0.0, max_steps: 100_000 }
+        Dp45 {
+            rtol,
+            h: 0.0,
+            max_steps: 100_000,
+        }
     }
 
     #[inline]
@@ -185,7 +193,11 @@ impl Dp45 {
             let sv = self.rtol * (m.scale[1] + v.abs().max(vn.abs()));
             let err = (0.5 * ((ex / sx).powi(2) + (ev / sv).powi(2))).sqrt();
             if err <= 1.0 {
-                let mut fac = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
+                let mut fac = if err == 0.0 {
+                    5.0
+                } else {
+                    (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
+                };
                 if rejected {
                     fac = fac.min(1.0);
                 }
@@ -203,7 +215,12 @@ impl Dp45 {
                 h = proposal;
             } else {
                 rejected = true;
-                h = hs * if err.is_finite() { (0.9 * err.powf(-0.2)).clamp(0.2, 1.0) } else { 0.25 };
+                h = hs
+                    * if err.is_finite() {
+                        (0.9 * err.powf(-0.2)).clamp(0.2, 1.0)
+                    } else {
+                        0.25
+                    };
                 if h < 1e-14 * dt {
                     return Err("DP45: step size underflow".into());
                 }

@@ -21,8 +21,18 @@ pub enum Param {
     Integer(u32, i32),
 }
 
-type SetReal = unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *const fmi2Real) -> fmi2Status;
-type GetReal = unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut fmi2Real) -> fmi2Status;
+type SetReal = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *const fmi2Real,
+) -> fmi2Status;
+type GetReal = unsafe extern "C" fn(
+    fmi2Component,
+    *const fmi2ValueReference,
+    usize,
+    *mut fmi2Real,
+) -> fmi2Status;
 type DoStep = unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> fmi2Status;
 
 pub struct Library {
@@ -51,7 +61,10 @@ impl Library {
         let _ = log::set_logger(&LOGGER).map(|()| log::set_max_level(log::LevelFilter::Warn));
         // SAFETY: loading the FMU's own library; its fmi2* symbols follow the FMI 2.0 ABI.
         let lib = unsafe { Fmi2Binding::new(path) }.map_err(|e| format!("load {path}: {e}"))?;
-        Ok(Library { lib, guid: CString::new(guid).map_err(|e| e.to_string())? })
+        Ok(Library {
+            lib,
+            guid: CString::new(guid).map_err(|e| e.to_string())?,
+        })
     }
 }
 
@@ -117,24 +130,39 @@ impl<'a> Instance<'a> {
             _callbacks: callbacks,
         };
         unsafe {
-            ok("fmi2SetupExperiment", l.fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0))?;
+            ok(
+                "fmi2SetupExperiment",
+                l.fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0),
+            )?;
             for p in params {
                 match *p {
-                    Param::Real(vr, v) => ok(&format!("fmi2SetReal(vr {vr})"), l.fmi2SetReal(c, &vr, 1, &v))?,
-                    Param::Integer(vr, v) => {
-                        ok(&format!("fmi2SetInteger(vr {vr})"), l.fmi2SetInteger(c, &vr, 1, &v))?
-                    }
+                    Param::Real(vr, v) => ok(
+                        &format!("fmi2SetReal(vr {vr})"),
+                        l.fmi2SetReal(c, &vr, 1, &v),
+                    )?,
+                    Param::Integer(vr, v) => ok(
+                        &format!("fmi2SetInteger(vr {vr})"),
+                        l.fmi2SetInteger(c, &vr, 1, &v),
+                    )?,
                 }
             }
-            ok("fmi2EnterInitializationMode", l.fmi2EnterInitializationMode(c))?;
-            ok("fmi2ExitInitializationMode", l.fmi2ExitInitializationMode(c))?;
+            ok(
+                "fmi2EnterInitializationMode",
+                l.fmi2EnterInitializationMode(c),
+            )?;
+            ok(
+                "fmi2ExitInitializationMode",
+                l.fmi2ExitInitializationMode(c),
+            )?;
         }
         Ok(inst)
     }
 
     pub fn get(&self, vr: u32) -> Result<f64, String> {
         let mut v = 0.0;
-        ok("fmi2GetReal", unsafe { (self.get_real)(self.c, &vr, 1, &mut v) })?;
+        ok("fmi2GetReal", unsafe {
+            (self.get_real)(self.c, &vr, 1, &mut v)
+        })?;
         Ok(v)
     }
 

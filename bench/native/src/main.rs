@@ -117,17 +117,16 @@ fn run_open<D: Damper>(d: &mut D, a: &[f64], dt: f64) -> Result<(u128, Vec<f64>)
     Ok((ns, xs))
 }
 
+/// What a timed run gives: (ns in the stepping loop, slosh.x at the communication points,
+/// the structure's X for the coupled scene), or the step it failed at and why.
+type RunResult = Result<(u128, Vec<f64>, Vec<f64>), (usize, String)>;
+
 /// The co-simulation master of the coupled scene (explicit, force held over the step):
 /// at t_k, a_tank = (F_k - C V_k - K X_k)/(M + m0) is given to the damper as base.a, the damper
 /// steps, and the structure is advanced over the same step by RK4 (`sub` substeps) with F_k
 /// held and the ground acceleration evaluated where RK4 needs it. bench.py's reference master
 /// performs the same operations in the same order.
-fn run_coupled<D: Damper>(
-    d: &mut D,
-    s: &Coupled,
-    m0: f64,
-    dt: f64,
-) -> Result<(u128, Vec<f64>, Vec<f64>), (usize, String)> {
+fn run_coupled<D: Damper>(d: &mut D, s: &Coupled, m0: f64, dt: f64) -> RunResult {
     let n = s.n;
     let mut xs = vec![0.0; n + 1];
     let mut big_x = vec![0.0; n + 1];
@@ -196,13 +195,19 @@ fn read_f64(path: &str, n: usize) -> Result<Vec<f64>, String> {
     if b.len() != 8 * n {
         return Err(format!("{path}: {} bytes, expected {}", b.len(), 8 * n));
     }
-    Ok(b.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect())
+    Ok(b.chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect())
 }
 
 fn median(v: &mut [u128]) -> u128 {
     v.sort_unstable();
     let n = v.len();
-    if n % 2 == 1 { v[n / 2] } else { (v[n / 2 - 1] + v[n / 2]) / 2 }
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        (v[n / 2 - 1] + v[n / 2]) / 2
+    }
 }
 
 #[derive(Default)]
@@ -226,7 +231,7 @@ enum Kind {
 }
 
 /// One repeat of a run: fresh damper, timed loop. Returns (ns, x, X).
-fn once(st: &Settings, kind: &Kind) -> Result<(u128, Vec<f64>, Vec<f64>), (usize, String)> {
+fn once(st: &Settings, kind: &Kind) -> RunResult {
     let e0 = |e: String| (0usize, e);
     match kind {
         Kind::Fmu(params) => {
@@ -243,18 +248,28 @@ fn once(st: &Settings, kind: &Kind) -> Result<(u128, Vec<f64>, Vec<f64>), (usize
         }
         Kind::Rk4(sub, abs_span) => {
             let model = st.model.ok_or((0, "no model".to_string()))?;
-            let mut d = Plain { model, integ: Rk4 { sub: *sub }, y: [0.0; 2], abs_span: *abs_span };
+            let mut d = Plain {
+                model,
+                integ: Rk4 { sub: *sub },
+                y: [0.0; 2],
+                abs_span: *abs_span,
+            };
             go(&mut d, st)
         }
         Kind::Dp45(rtol) => {
             let model = st.model.ok_or((0, "no model".to_string()))?;
-            let mut d = Plain { model, integ: Dp45::new(*rtol), y: [0.0; 2], abs_span: false };
+            let mut d = Plain {
+                model,
+                integ: Dp45::new(*rtol),
+                y: [0.0; 2],
+                abs_span: false,
+            };
             go(&mut d, st)
         }
     }
 }
 
-fn go<D: Damper>(d: &mut D, st: &Settings) -> Result<(u128, Vec<f64>, Vec<f64>), (usize, String)> {
+fn go<D: Damper>(d: &mut D, st: &Settings) -> RunResult {
     match &st.coupled {
         Some(c) => run_coupled(d, c, c.m0, st.dt),
         None => run_open(d, &st.input, st.dt).map(|(ns, x)| (ns, x, vec![])),
@@ -275,7 +290,10 @@ fn main() {
 
 fn real_main(jobfile: &str) -> Result<(), String> {
     let text = std::fs::read_to_string(jobfile).map_err(|e| format!("{jobfile}: {e}"))?;
-    let mut st = Settings { repeats: 3, ..Default::default() };
+    let mut st = Settings {
+        repeats: 3,
+        ..Default::default()
+    };
     let stdout = std::io::stdout();
     for (lineno, line) in text.lines().enumerate() {
         let tok: Vec<&str> = line.split_whitespace().collect();
@@ -345,8 +363,14 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                             let (ty, vr) = head.split_once(':').ok_or(err(format!("bad {t}")))?;
                             let vr: u32 = vr.parse().map_err(|e| err(format!("{t}: {e}")))?;
                             params.push(match ty {
-                                "R" => fmu::Param::Real(vr, val.parse().map_err(|e| err(format!("{t}: {e}")))?),
-                                "I" => fmu::Param::Integer(vr, val.parse().map_err(|e| err(format!("{t}: {e}")))?),
+                                "R" => fmu::Param::Real(
+                                    vr,
+                                    val.parse().map_err(|e| err(format!("{t}: {e}")))?,
+                                ),
+                                "I" => fmu::Param::Integer(
+                                    vr,
+                                    val.parse().map_err(|e| err(format!("{t}: {e}")))?,
+                                ),
                                 _ => return Err(err(format!("bad type in {t}"))),
                             });
                         }
@@ -389,7 +413,13 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                         }
                         let all: Vec<String> = times.iter().map(|t| t.to_string()).collect();
                         let med = median(&mut times.clone());
-                        writeln!(out, "result {id} ok {} {med} {}", x.len() - 1, all.join(",")).ok();
+                        writeln!(
+                            out,
+                            "result {id} ok {} {med} {}",
+                            x.len() - 1,
+                            all.join(",")
+                        )
+                        .ok();
                     }
                 }
                 out.flush().ok();

@@ -1,7 +1,8 @@
 """Independent reference solutions for the TLD.fmu tests.
 
-Written from the equations in shared/spec/MODEL.md and the FMU contract (modelDescription.xml),
-sharing no code with the Rust FMU. Nothing here loads the FMU.
+Written from the equations in shared/spec/MODEL.md and the FMU contract (modelDescription.xml,
+whose enumeration values it reads through tld_fmu.contract), sharing no code with the Rust FMU.
+Nothing here loads the FMU.
 
 Model (per tank, totals = `tanks` times):
     M_l = rho a b h,  r = h/a
@@ -37,12 +38,14 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-# enumeration integer values of the FMU (modelDescription.xml, fmi2SetInteger values)
-DAMPING_CONSTANT, DAMPING_NSD = 1, 2
-AMPLITUDE_FIXED, AMPLITUDE_TRACKED = 1, 2
-SOLVER_DP45, SOLVER_RK4 = 1, 2
-SOLVER_RK5, SOLVER_RK8, SOLVER_EXPRK4 = 6, 7, 8
-MODEL_NONLINEAR = 2
+from .contract import item
+
+# the enumeration values the parameters below use, by item name from the contract
+DAMPING_CONSTANT, DAMPING_NSD = item("damping", "Constant"), item("damping", "NSD")
+AMPLITUDE_FIXED, AMPLITUDE_TRACKED = item("amplitude", "Fixed"), item("amplitude", "Tracked")
+SOLVER_DP45, SOLVER_RK4 = item("solver", "DormandPrince45"), item("solver", "RK4")
+SOLVER_RK5, SOLVER_RK8, SOLVER_EXPRK4 = item("solver", "RK5"), item("solver", "RK8"), item("solver", "ExpRK4")
+MODEL_NONLINEAR = item("model", "Nonlinear")
 
 
 def geometry(a=0.25, b=0.32, h=0.021, rho=1000.0, g=9.81, tanks=1):

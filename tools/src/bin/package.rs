@@ -1,7 +1,7 @@
 //! Packs TLD.fmu: modelDescription.xml, binaries/linux64/TLD.so and documentation/index.html
 //! (prose from modelDescription/documentation.html, variable table from the generated table).
 //!
-//! Usage: tld-package <output .fmu> <library> [<library> ...]
+//! Usage: tld-package <output .fmu> <library> [<library> ...] (scripts/package)
 
 use std::io::Write;
 use std::path::Path;
@@ -9,8 +9,14 @@ use std::path::Path;
 use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType, Variable};
 use zip::write::SimpleFileOptions;
 
-const XML: &str = include_str!("../../modelDescription/modelDescription.xml");
-const DOC: &str = include_str!("../../modelDescription/documentation.html");
+const XML: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../modelDescription/modelDescription.xml"
+));
+const DOC: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../modelDescription/documentation.html"
+));
 
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;")

@@ -1,0 +1,92 @@
+"""The FMU's contract, read from modelDescription.xml with fmpy: value references by variable
+name and enumeration values by item name, so that Python never repeats the XML's integers.
+
+    from tld_fmu.contract import vr, item
+    vr("base.a")                 # value reference of base.a
+    item("solver", "ExpRK4")     # fmi2SetInteger value of the solver's item ExpRK4
+
+The module-level functions read the repository's modelDescription/modelDescription.xml (the
+XML the FMU packs unchanged); `Contract(path_or_model_description)` reads another one, e.g. a
+packed FMU's."""
+from __future__ import annotations
+
+import functools
+
+from .paths import MODEL_DESCRIPTION
+
+
+class Contract:
+    """The variables of one modelDescription: source is an FMU, an unpacked FMU directory, a
+    modelDescription.xml or a model description fmpy has read."""
+
+    def __init__(self, source=MODEL_DESCRIPTION):
+        if hasattr(source, "modelVariables"):
+            self.md = source
+        else:
+            from fmpy import read_model_description
+            self.md = read_model_description(str(source))
+        self.variables = {v.name: v for v in self.md.modelVariables}
+
+    def variable(self, name: str):
+        try:
+            return self.variables[name]
+        except KeyError:
+            raise KeyError(f"no variable {name!r} in the modelDescription") from None
+
+    def vr(self, name: str) -> int:
+        """The value reference of variable `name`."""
+        return self.variable(name).valueReference
+
+    def items(self, name: str) -> list[tuple[str, int, str]]:
+        """[(item name, value, description)] of the Enumeration variable `name`."""
+        v = self.variable(name)
+        if v.type != "Enumeration":
+            raise TypeError(f"{name} is a {v.type}, not an Enumeration")
+        return [(i.name, int(i.value), i.description or "") for i in v.declaredType.items]
+
+    def item(self, name: str, item: str) -> int:
+        """The value of item `item` of the Enumeration variable `name` (the fmi2SetInteger
+        value)."""
+        for n, value, _ in self.items(name):
+            if n == item:
+                return value
+        raise KeyError(f"{name} has no item {item!r}: {[n for n, _, _ in self.items(name)]}")
+
+    def value(self, name: str, value):
+        """A parameter value as the FMU takes it: an Enumeration's item may be given by name."""
+        if isinstance(value, str) and self.variable(name).type == "Enumeration":
+            return self.item(name, value)
+        return value
+
+    def set(self, fmu, values: dict):
+        """Set {name: value} on an fmpy FMU2Slave, each through its type's setter (an
+        Enumeration's item by name or value)."""
+        for name, value in values.items():
+            v = self.variable(name)
+            value = self.value(name, value)
+            if v.type == "Real":
+                fmu.setReal([v.valueReference], [float(value)])
+            elif v.type in ("Integer", "Enumeration"):
+                fmu.setInteger([v.valueReference], [int(value)])
+            elif v.type == "Boolean":
+                fmu.setBoolean([v.valueReference], [bool(value)])
+            else:
+                raise TypeError(f"{name}: type {v.type}")
+
+
+@functools.cache
+def default() -> Contract:
+    """The repository's modelDescription/modelDescription.xml, read once."""
+    return Contract()
+
+
+def vr(name: str) -> int:
+    return default().vr(name)
+
+
+def item(name: str, item: str) -> int:
+    return default().item(name, item)
+
+
+def items(name: str) -> list[tuple[str, int, str]]:
+    return default().items(name)
