@@ -1,6 +1,9 @@
-//! The only place that speaks FMI: exported fmi2* functions (thin, panic-safe), the instance and
-//! its call-sequence state machine, variable access and logging.
+//! The only place that speaks FMI: exported fmi2* functions (thin, panic-safe, each checked
+//! against its phase mask first), the instance and its call sequence, variable access, the
+//! saved-state format and logging.
 
+mod access;
+mod calls;
 mod exports;
 #[cfg(test)]
 mod generated_tests;
@@ -8,8 +11,8 @@ mod instance;
 mod logger;
 mod params;
 mod snapshot;
+mod status;
 
 /// The model description's table, where the FMI layer has always offered it.
 pub use crate::description as vars;
-
-pub use instance::Status;
+pub use status::Status;

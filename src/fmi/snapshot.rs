@@ -12,8 +12,12 @@
 //! ```
 //! All numbers little-endian.
 
-use super::instance::{Refusal, refuse};
+use super::calls::Phase;
+use super::instance::{Experiment, Instance};
+use super::params::{Configuration, Values};
+use super::status::{Refusal, Reply, Status, refuse};
 use super::vars::GUID;
+use crate::model::Damper;
 
 const MAGIC: &[u8; 4] = b"TLDs";
 pub const FORMAT_VERSION: u16 = 1;
@@ -181,5 +185,108 @@ impl<'a> Reader<'a> {
             ));
         }
         (0..n).map(|_| self.f64()).collect()
+    }
+}
+
+/// A saved state, checked and ready to become the instance.
+struct Restored {
+    phase: Phase,
+    values: Values,
+    experiment: Experiment,
+    user_tolerance: bool,
+    time: f64,
+    a_derivatives: [f64; 2],
+    sim: Option<Damper>,
+}
+
+impl Instance {
+    /// The whole instance (less what the host gave it) as bytes.
+    pub fn save(&self) -> Vec<u8> {
+        Saved {
+            phase: match self.phase {
+                Phase::Instantiated => 0,
+                Phase::InitializationMode => 1,
+                Phase::StepComplete => 2,
+                Phase::Terminated | Phase::Broken => 3,
+            },
+            user_tolerance: self.user_tolerance,
+            tolerance: self.experiment.tolerance,
+            start: self.experiment.start,
+            stop: self.experiment.stop,
+            time: self.time,
+            a_derivatives: self.a_derivatives,
+            values: self.values.as_slice().to_vec(),
+            simulation: self.sim.as_ref().map(Damper::snapshot).unwrap_or_default(),
+        }
+        .encode()
+    }
+
+    /// Check a saved state completely, without applying it.
+    pub fn check_saved(bytes: &[u8]) -> Result<(), Refusal> {
+        Self::restored(bytes).map(|_| ())
+    }
+
+    /// Become the instance `bytes` describes; on any error nothing changes.
+    pub fn load(&mut self, bytes: &[u8]) -> Reply {
+        let r = Self::restored(bytes)?;
+        self.phase = r.phase;
+        self.values = r.values;
+        self.experiment = r.experiment;
+        self.user_tolerance = r.user_tolerance;
+        self.time = r.time;
+        self.a_derivatives = r.a_derivatives;
+        self.sim = r.sim;
+        Ok(Status::Ok)
+    }
+
+    fn restored(bytes: &[u8]) -> Result<Restored, Refusal> {
+        let bad = |why: String| refuse(format!("the FMU state is not usable: {why}"));
+        let s = Saved::decode(bytes).map_err(|r| bad(*r.message))?;
+        let phase = match s.phase {
+            0 => Phase::Instantiated,
+            1 => Phase::InitializationMode,
+            2 => Phase::StepComplete,
+            3 => Phase::Terminated,
+            other => return Err(bad(format!("unknown state code {other}"))),
+        };
+        let [d1, d2] = s.a_derivatives;
+        let finite = [s.time, s.start, s.stop.unwrap_or(0.0), d1, d2]
+            .iter()
+            .all(|x| x.is_finite());
+        let tolerance_ok = s.tolerance.is_none_or(|t| t.is_finite() && t > 0.0);
+        if !finite || !tolerance_ok {
+            return Err(bad(
+                "non-finite time, tolerance, experiment bounds or input derivatives".into(),
+            ));
+        }
+        let values = Values::from_saved(&s.values).map_err(bad)?;
+        let initialised = matches!(phase, Phase::StepComplete | Phase::Terminated);
+        let sim = if initialised {
+            let configuration = Configuration {
+                values: &values,
+                tolerance: s.tolerance,
+                user_tolerance: s.user_tolerance,
+            };
+            Some(Damper::restore(&configuration, &s.simulation).map_err(bad)?)
+        } else if s.simulation.is_empty() {
+            None
+        } else {
+            return Err(bad(
+                "simulation values in a state before initialisation".into()
+            ));
+        };
+        Ok(Restored {
+            phase,
+            values,
+            experiment: Experiment {
+                tolerance: s.tolerance,
+                start: s.start,
+                stop: s.stop,
+            },
+            user_tolerance: s.user_tolerance,
+            time: s.time,
+            a_derivatives: s.a_derivatives,
+            sim,
+        })
     }
 }

@@ -92,7 +92,17 @@ impl Model for NonlinearAuto {
 
     #[inline(always)]
     fn step(&mut self, step: &Interval) -> Result<Stepped, StepError> {
-        self.nonlinear.step_with(step, Some(&mut self.linear))
+        let a = step.base.a;
+        self.nonlinear.step_with(
+            step.t,
+            step.h,
+            step.zeta,
+            a[0],
+            a[1],
+            a[2],
+            step.limit,
+            Some(&mut self.linear),
+        )
     }
 
     #[inline(always)]

@@ -1,0 +1,170 @@
+//! FMU states: fmi2GetFMUstate and its kin. A state is the instance's serialised bytes (one
+//! format, `snapshot`, for in-memory and serialised states) in a marked box.
+
+use fmi_sys::fmi2::*;
+
+use super::{guard, host_ref, host_slice, host_slice_mut};
+use crate::fmi::calls::{self, Call};
+use crate::fmi::instance::Instance;
+use crate::fmi::status::{Refusal, Status, refuse};
+
+/// What an fmi2FMUstate points to: the instance's state in its serialised form (one code path
+/// for in-memory and serialised states), with a mark to recognise it.
+struct StateBox {
+    magic: u64,
+    bytes: Vec<u8>,
+}
+
+const STATE_MAGIC: u64 = 0x544c_445f_5354_4154;
+
+/// The state behind a host's fmi2FMUstate, if it is one of ours.
+unsafe fn state_box<'a>(state: fmi2FMUstate, function: &str) -> Result<&'a mut StateBox, Refusal> {
+    let p = state as *mut StateBox;
+    // SAFETY: non-null, aligned, and marked: a state this library allocated and did not free.
+    if !p.is_null() && p.is_aligned() && unsafe { (*p).magic } == STATE_MAGIC {
+        Ok(unsafe { &mut *p })
+    } else {
+        Err(refuse(format!(
+            "{function}: the FMU state pointer is null or not a state of this FMU"
+        )))
+    }
+}
+
+fn new_state(bytes: Vec<u8>) -> fmi2FMUstate {
+    Box::into_raw(Box::new(StateBox {
+        magic: STATE_MAGIC,
+        bytes,
+    })) as fmi2FMUstate
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    const CALL: &Call = &calls::GET_FMU_STATE;
+    guard(c, CALL, |inst| {
+        // SAFETY: host output scalar.
+        let out = unsafe { host_ref(FMUstate, CALL, "FMUstate")? };
+        let bytes = inst.save();
+        if out.is_null() {
+            *out = new_state(bytes);
+        } else {
+            // The host hands back a state to overwrite.
+            unsafe { state_box(*out, "fmi2GetFMUstate")? }.bytes = bytes;
+        }
+        Ok(Status::Ok)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
+    const CALL: &Call = &calls::SET_FMU_STATE;
+    guard(c, CALL, |inst| {
+        // SAFETY: a host state pointer, recognised by its mark.
+        let state = unsafe { state_box(FMUstate, "fmi2SetFMUstate")? };
+        inst.load(&state.bytes)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2FreeFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    const CALL: &Call = &calls::FREE_FMU_STATE;
+    guard(c, CALL, |_| {
+        // SAFETY: host in-out scalar.
+        let slot = unsafe { host_ref(FMUstate, CALL, "FMUstate")? };
+        if slot.is_null() {
+            return Ok(Status::Ok);
+        }
+        // SAFETY: a state of ours: unmark, then take the box back exactly once.
+        let state = unsafe { state_box(*slot, "fmi2FreeFMUstate")? };
+        state.magic = 0;
+        drop(unsafe { Box::from_raw(state as *mut StateBox) });
+        *slot = std::ptr::null_mut();
+        Ok(Status::Ok)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    const CALL: &Call = &calls::SERIALIZED_FMU_STATE_SIZE;
+    guard(c, CALL, |_| {
+        // SAFETY: host state and output scalar.
+        let (state, out) = unsafe {
+            (
+                state_box(FMUstate, "fmi2SerializedFMUstateSize")?,
+                host_ref(size, CALL, "size")?,
+            )
+        };
+        *out = state.bytes.len();
+        Ok(Status::Ok)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    serializedState: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    const CALL: &Call = &calls::SERIALIZE_FMU_STATE;
+    guard(c, CALL, |_| {
+        // SAFETY: host state pointer.
+        let state = unsafe { state_box(FMUstate, "fmi2SerializeFMUstate")? };
+        if size != state.bytes.len() {
+            return Err(refuse(format!(
+                "fmi2SerializeFMUstate: size {size} is not the serialised size {} (ask fmi2SerializedFMUstateSize)",
+                state.bytes.len()
+            )));
+        }
+        // SAFETY: host buffer of `size` bytes.
+        let out = unsafe { host_slice_mut(serializedState as *mut u8, size, CALL, "buffer")? };
+        out.copy_from_slice(&state.bytes);
+        Ok(Status::Ok)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+    c: fmi2Component,
+    serializedState: *const fmi2Byte,
+    size: usize,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    const CALL: &Call = &calls::DE_SERIALIZE_FMU_STATE;
+    guard(c, CALL, |_| {
+        // SAFETY: host buffer of `size` bytes and host output scalar.
+        let (bytes, out) = unsafe {
+            (
+                host_slice(serializedState as *const u8, size, CALL, "buffer")?,
+                host_ref(FMUstate, CALL, "FMUstate")?,
+            )
+        };
+        Instance::check_saved(bytes)
+            .map_err(|r| refuse(format!("fmi2DeSerializeFMUstate: {}", r.message)))?;
+        // A host may hand back one of our states for reuse (fmpy does); anything else in the
+        // slot is not ours to free, and a new state is made.
+        // SAFETY: a host state pointer, recognised by its mark.
+        match unsafe { state_box(*out, "fmi2DeSerializeFMUstate") } {
+            Ok(state) => state.bytes = bytes.to_vec(),
+            Err(_) => *out = new_state(bytes.to_vec()),
+        }
+        Ok(Status::Ok)
+    })
+}
+
+// The signatures above must match the FMI 2.0 headers exactly.
+const _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
+const _: fmi2SetFMUstateTYPE = Some(fmi2SetFMUstate);
+const _: fmi2FreeFMUstateTYPE = Some(fmi2FreeFMUstate);
+const _: fmi2SerializedFMUstateSizeTYPE = Some(fmi2SerializedFMUstateSize);
+const _: fmi2SerializeFMUstateTYPE = Some(fmi2SerializeFMUstate);
+const _: fmi2DeSerializeFMUstateTYPE = Some(fmi2DeSerializeFMUstate);

@@ -1,0 +1,315 @@
+//! Variable access: one generic path for the Real, Integer and Boolean getters and setters,
+//! String access (this FMU has no String variables), and the input and output derivatives.
+
+use fmi_sys::fmi2::*;
+
+use super::{arrays, guard, host_slice, host_slice_mut};
+use crate::fmi::calls::{self, Call};
+use crate::fmi::instance::Instance;
+use crate::fmi::status::{Reply, Status, refuse};
+use crate::fmi::vars::VarType;
+
+/// How one FMI value type travels to and from the instance's f64 values.
+trait Access {
+    type Host: Copy;
+    const TYPE: VarType;
+    fn to_host(value: f64) -> Self::Host;
+    fn from_host(value: Self::Host) -> f64;
+}
+
+struct Reals;
+struct Integers;
+struct Booleans;
+
+impl Access for Reals {
+    type Host = fmi2Real;
+    const TYPE: VarType = VarType::Real;
+    #[inline(always)]
+    fn to_host(value: f64) -> fmi2Real {
+        value
+    }
+    #[inline(always)]
+    fn from_host(value: fmi2Real) -> f64 {
+        value
+    }
+}
+
+impl Access for Integers {
+    type Host = fmi2Integer;
+    const TYPE: VarType = VarType::Integer;
+    fn to_host(value: f64) -> fmi2Integer {
+        value as fmi2Integer
+    }
+    fn from_host(value: fmi2Integer) -> f64 {
+        f64::from(value)
+    }
+}
+
+impl Access for Booleans {
+    type Host = fmi2Boolean;
+    const TYPE: VarType = VarType::Boolean;
+    fn to_host(value: f64) -> fmi2Boolean {
+        fmi2Boolean::from(value != 0.0)
+    }
+    fn from_host(value: fmi2Boolean) -> f64 {
+        f64::from(i32::from(value != 0))
+    }
+}
+
+/// fmi2Get{Real,Integer,Boolean}. A running instance's per-step reads (stored values and the
+/// outputs read after every step, nothing to log) exit early, by loads only; everything else
+/// goes the whole way, [`get_in_full`], where the same loads are tried first.
+#[inline(always)]
+unsafe fn get<A: Access>(
+    c: fmi2Component,
+    call: &'static Call,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut A::Host,
+) -> fmi2Status {
+    // SAFETY: `c` as in `guard`; the arrays are the host's nvr elements, checked by `arrays`.
+    unsafe {
+        if let Some(inst) = Instance::from_ptr(c)
+            && inst.quiet(call)
+            && let Some((vrs, out)) = arrays(vr, value, nvr)
+            && inst.load_all(vrs, out, A::TYPE, A::to_host)
+        {
+            return Status::Ok as fmi2Status;
+        }
+        get_in_full::<A>(c, call, vr, nvr, value)
+    }
+}
+
+#[inline(never)]
+unsafe fn get_in_full<A: Access>(
+    c: fmi2Component,
+    call: &'static Call,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut A::Host,
+) -> fmi2Status {
+    guard(c, call, |inst| {
+        // SAFETY: host arrays of nvr elements.
+        let (vrs, out) = unsafe {
+            (
+                host_slice(vr, nvr, call, "vr")?,
+                host_slice_mut(value, nvr, call, "value")?,
+            )
+        };
+        inst.get(vrs, out, A::TYPE, call.name, A::to_host)
+    })
+}
+
+/// fmi2Set{Real,Integer,Boolean}. The per-step input (one unbounded Real input, nothing to log)
+/// exits early by one table look-up; everything else goes the whole way, [`set_in_full`], whose
+/// check begins with the same look-up.
+#[inline(always)]
+unsafe fn set<A: Access>(
+    c: fmi2Component,
+    call: &'static Call,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const A::Host,
+) -> fmi2Status {
+    // SAFETY: as in `get`.
+    unsafe {
+        if let Some(inst) = Instance::from_ptr(c)
+            && inst.quiet(call)
+            && nvr == 1
+            && let Some((vrs, values)) = arrays(vr, value as *mut A::Host, 1)
+            && inst.set_input(vrs[0], A::from_host(values[0]), A::TYPE)
+        {
+            return Status::Ok as fmi2Status;
+        }
+        set_in_full::<A>(c, call, vr, nvr, value)
+    }
+}
+
+#[inline(never)]
+unsafe fn set_in_full<A: Access>(
+    c: fmi2Component,
+    call: &'static Call,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const A::Host,
+) -> fmi2Status {
+    guard(c, call, |inst| {
+        // SAFETY: host arrays of nvr elements.
+        let (vrs, values) = unsafe {
+            (
+                host_slice(vr, nvr, call, "vr")?,
+                host_slice(value, nvr, call, "value")?,
+            )
+        };
+        inst.set(vrs, values, A::TYPE, call.name, A::from_host)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetReal(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    // SAFETY: the host's arguments, checked before use.
+    unsafe { get::<Reals>(c, &calls::GET_REAL, vr, nvr, value) }
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetInteger(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Integer,
+) -> fmi2Status {
+    // SAFETY: as above.
+    unsafe { get::<Integers>(c, &calls::GET_INTEGER, vr, nvr, value) }
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetBoolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    // SAFETY: as above.
+    unsafe { get::<Booleans>(c, &calls::GET_BOOLEAN, vr, nvr, value) }
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetReal(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2Real,
+) -> fmi2Status {
+    // SAFETY: as above.
+    unsafe { set::<Reals>(c, &calls::SET_REAL, vr, nvr, value) }
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetInteger(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2Integer,
+) -> fmi2Status {
+    // SAFETY: as above.
+    unsafe { set::<Integers>(c, &calls::SET_INTEGER, vr, nvr, value) }
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetBoolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2Boolean,
+) -> fmi2Status {
+    // SAFETY: as above.
+    unsafe { set::<Booleans>(c, &calls::SET_BOOLEAN, vr, nvr, value) }
+}
+
+/// This FMU has no String variables: any value reference is unknown.
+fn no_strings(vrs: &[u32], call: &Call) -> Reply {
+    match vrs.first() {
+        None => Ok(Status::Ok),
+        Some(r) => Err(refuse(format!(
+            "{}: unknown value reference {r} (this FMU has no String variables)",
+            call.name
+        ))),
+    }
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetString(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2String,
+) -> fmi2Status {
+    const CALL: &Call = &calls::GET_STRING;
+    guard(c, CALL, |_| {
+        // SAFETY: host arrays of nvr elements.
+        let vrs = unsafe {
+            host_slice_mut(value, nvr, CALL, "value")?;
+            host_slice(vr, nvr, CALL, "vr")?
+        };
+        no_strings(vrs, CALL)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetString(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2String,
+) -> fmi2Status {
+    const CALL: &Call = &calls::SET_STRING;
+    guard(c, CALL, |_| {
+        // SAFETY: host arrays of nvr elements.
+        let vrs = unsafe {
+            host_slice(value, nvr, CALL, "value")?;
+            host_slice(vr, nvr, CALL, "vr")?
+        };
+        no_strings(vrs, CALL)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    order: *const fmi2Integer,
+    value: *const fmi2Real,
+) -> fmi2Status {
+    const CALL: &Call = &calls::SET_REAL_INPUT_DERIVATIVES;
+    guard(c, CALL, |inst: &mut Instance| {
+        // SAFETY: host arrays of nvr elements.
+        let (vrs, orders, values) = unsafe {
+            (
+                host_slice(vr, nvr, CALL, "vr")?,
+                host_slice(order, nvr, CALL, "order")?,
+                host_slice(value, nvr, CALL, "value")?,
+            )
+        };
+        inst.set_input_derivatives(vrs, orders, values)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    order: *const fmi2Integer,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    const CALL: &Call = &calls::GET_REAL_OUTPUT_DERIVATIVES;
+    guard(c, CALL, |inst| {
+        // SAFETY: host arrays of nvr elements.
+        let (vrs, orders, out) = unsafe {
+            (
+                host_slice(vr, nvr, CALL, "vr")?,
+                host_slice(order, nvr, CALL, "order")?,
+                host_slice_mut(value, nvr, CALL, "value")?,
+            )
+        };
+        inst.output_derivatives(vrs, orders, |k, v| out[k] = v)
+    })
+}
+
+// The signatures above must match the FMI 2.0 headers exactly.
+const _: fmi2GetRealTYPE = Some(fmi2GetReal);
+const _: fmi2GetIntegerTYPE = Some(fmi2GetInteger);
+const _: fmi2GetBooleanTYPE = Some(fmi2GetBoolean);
+const _: fmi2GetStringTYPE = Some(fmi2GetString);
+const _: fmi2SetRealTYPE = Some(fmi2SetReal);
+const _: fmi2SetIntegerTYPE = Some(fmi2SetInteger);
+const _: fmi2SetBooleanTYPE = Some(fmi2SetBoolean);
+const _: fmi2SetStringTYPE = Some(fmi2SetString);
+const _: fmi2SetRealInputDerivativesTYPE = Some(fmi2SetRealInputDerivatives);
+const _: fmi2GetRealOutputDerivativesTYPE = Some(fmi2GetRealOutputDerivatives);
