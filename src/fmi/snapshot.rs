@@ -9,7 +9,12 @@
 //!        | derivatives of base.a for the next step (orders 1, 2) f64
 //!        | number of variables u32 | their values f64...
 //!        | number of simulation values u32 (0: not initialised) | the values f64...
+//! simulation values: the model's own part (`Model::save`: its state, then three numbers the
+//!        integrator carries, 0 for the exact models) | the damper's frame (amplitude, mean-force
+//!        flag and value, amplitude estimator: `Damper::snapshot`)
 //! ```
+//! tests/golden/ holds a state of this version for every model: the layout cannot change
+//! without a test failing (tests/golden_state.rs).
 //! All numbers little-endian.
 
 use super::calls::Phase;

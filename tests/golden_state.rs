@@ -1,0 +1,140 @@
+//! The saved-state layout is pinned: a state of format version 1 for every model is committed
+//! under tests/golden/. A run that reaches the same point must serialise to exactly those bytes,
+//! and the committed bytes, restored into a new instance, must continue exactly as the
+//! uninterrupted run. A change of the layout (or of what a model saves) fails here; regenerate
+//! the files with `TLD_BLESS=1 cargo test --test golden_state` only together with a new format
+//! version or a deliberate change of the numbers, and say so in the commit.
+//!
+//! The input is built from + and * only, so the scene is the same wherever it runs; the
+//! model's own libm calls (exp, sin, cos of the propagators) make the bytes those of this
+//! platform (x86_64 Linux, glibc).
+
+mod common;
+
+use common::*;
+use fmi_sys::fmi2::fmi2FMUstate;
+use std::path::PathBuf;
+use tld_fmu::fmi::vars::{AmplitudeModeItem, ModelKindItem, vr};
+
+/// Steps before the state is taken, and after.
+const BEFORE: usize = 150;
+const AFTER: usize = 100;
+const H: f64 = 0.01;
+
+/// A triangle wave of base acceleration, 0.4 s period, +-0.8 m/s^2: arithmetic only.
+fn base_a(k: usize) -> f64 {
+    let phase = (k % 40) as f64;
+    let tri = if phase < 20.0 {
+        phase - 10.0
+    } else {
+        30.0 - phase
+    };
+    0.08 * tri
+}
+
+fn configured(name: &str, model: ModelKindItem) -> Instance {
+    let inst = Instance::new(name);
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.set_integer(vr::MODEL, model.value() as i32), OK);
+    // The tracked amplitude saves its estimator too.
+    assert_eq!(
+        inst.set_integer(vr::AMPLITUDE, AmplitudeModeItem::Tracked.value() as i32),
+        OK
+    );
+    if model == ModelKindItem::Linear {
+        assert_eq!(inst.set_integer(vr::MODES, 3), OK);
+    }
+    if model == ModelKindItem::SloshingSlamming {
+        // A clearance small enough for impacts within the run.
+        assert_eq!(inst.set_real(vr::SLAMMING_CLEARANCE, 0.01), OK);
+    }
+    assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
+    inst
+}
+
+/// Steps k = from..to; slosh.x and force after each.
+fn run(inst: &mut Instance, from: usize, to: usize) -> Vec<(u64, u64)> {
+    (from..to)
+        .map(|k| {
+            assert_eq!(inst.set_real(vr::BASE_A, base_a(k)), OK);
+            assert_eq!(inst.do_step(H), OK, "{:?}", inst.logs());
+            (
+                inst.get_real(vr::SLOSH_X).1.to_bits(),
+                inst.get_real(vr::FORCE).1.to_bits(),
+            )
+        })
+        .collect()
+}
+
+fn state_bytes(inst: &Instance) -> Vec<u8> {
+    let mut s: fmi2FMUstate = std::ptr::null_mut();
+    let mut n = 0usize;
+    // SAFETY: our instance; the state is freed below.
+    unsafe {
+        assert_eq!(inst.lib.fmi2GetFMUstate(inst.c, &mut s), OK);
+        assert_eq!(inst.lib.fmi2SerializedFMUstateSize(inst.c, s, &mut n), OK);
+        let mut bytes = vec![0u8; n];
+        let buffer = bytes.as_mut_ptr() as *mut _;
+        assert_eq!(inst.lib.fmi2SerializeFMUstate(inst.c, s, buffer, n), OK);
+        assert_eq!(inst.lib.fmi2FreeFMUstate(inst.c, &mut s), OK);
+        bytes
+    }
+}
+
+fn restore(inst: &Instance, bytes: &[u8]) {
+    let mut s: fmi2FMUstate = std::ptr::null_mut();
+    // SAFETY: our instance and a buffer of bytes.len() bytes.
+    unsafe {
+        let buffer = bytes.as_ptr() as *const _;
+        assert_eq!(
+            inst.lib
+                .fmi2DeSerializeFMUstate(inst.c, buffer, bytes.len(), &mut s),
+            OK,
+            "{:?}",
+            inst.logs()
+        );
+        assert_eq!(inst.lib.fmi2SetFMUstate(inst.c, s), OK, "{:?}", inst.logs());
+        assert_eq!(inst.lib.fmi2FreeFMUstate(inst.c, &mut s), OK);
+    }
+}
+
+fn golden(model: ModelKindItem) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden")
+        .join(format!("state-v1-{}.bin", model.name()))
+}
+
+#[test]
+fn committed_states_of_version_1_restore_and_continue_bit_for_bit() {
+    let bless = std::env::var_os("TLD_BLESS").is_some();
+    for model in ModelKindItem::ALL {
+        let mut source = configured(&format!("golden-{}", model.name()), model);
+        run(&mut source, 0, BEFORE);
+        let bytes = state_bytes(&source);
+        let uninterrupted = run(&mut source, BEFORE, BEFORE + AFTER);
+        let path = golden(model);
+        if bless {
+            std::fs::write(&path, &bytes).expect("write the golden state");
+        }
+        let committed = std::fs::read(&path)
+            .unwrap_or_else(|e| panic!("{}: {e} (TLD_BLESS=1 writes it)", path.display()));
+        // The header: magic, then the format version, little-endian.
+        assert_eq!(&committed[..4], b"TLDs");
+        assert_eq!(u16::from_le_bytes([committed[4], committed[5]]), 1);
+        assert!(
+            committed == bytes,
+            "{}: the state this build saves differs from the committed one ({} vs {} bytes, first difference at byte {:?})",
+            model.name(),
+            bytes.len(),
+            committed.len(),
+            committed.iter().zip(&bytes).position(|(a, b)| a != b)
+        );
+        let mut target = Instance::new(&format!("golden-target-{}", model.name()));
+        restore(&target, &committed);
+        target.time = BEFORE as f64 * H;
+        let continued = run(&mut target, BEFORE, BEFORE + AFTER);
+        assert_eq!(continued, uninterrupted, "{}", model.name());
+        assert_ne!(continued[AFTER - 1].0, 0f64.to_bits(), "the run must slosh");
+    }
+}
