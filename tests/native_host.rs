@@ -4,7 +4,7 @@ mod common;
 
 use common::*;
 use std::ffi::CString;
-use tld_fmu::fmi::vars::{GUID, vr};
+use tld_fmu::fmi::vars::{AmplitudeModeItem, GUID, vr};
 use tld_fmu::model::{Damper, Inputs, Output, StartValues};
 
 /// The FMI layer adds nothing and loses nothing: the same run through the C interface and
@@ -782,6 +782,12 @@ fn output_derivatives_match_finite_differences() {
     assert_eq!(inst.setup(), OK);
     assert_eq!(inst.enter(), OK);
     assert_eq!(inst.set_real(vr::ETA, 3.0), OK);
+    // A fixed amplitude: a tracked one moves the damping at every communication point (by
+    // O(h) per step), which a difference over steps of d would count as a rate.
+    assert_eq!(
+        inst.set_integer(vr::AMPLITUDE, AmplitudeModeItem::Fixed.value() as i32),
+        OK
+    );
     assert_eq!(inst.exit(), OK);
     inst.run_harmonic(120, 0.01);
     let a_now = 0.7;

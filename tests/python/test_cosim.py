@@ -16,7 +16,7 @@ def test_cosimulation_converges_to_monolithic(unzipdir):
     w, A_g, t_end = demo.W_S, 1e-4, 20.0
     errs = {}
     for h in (2e-3, 1e-3):
-        r = demo.cosimulate(unzipdir, w, A_g, h, t_end, params={"A_e": p.A_e}, t_window=5.0,
+        r = demo.cosimulate(unzipdir, w, A_g, h, t_end, params={"A_e": p.A_e, "amplitude": "Fixed"}, t_window=5.0,
                             record=True)
         X, V, x, v = R.coupled_monolithic(p, demo.M_S, demo.C_S, demo.K_S, w, A_g, r["t"])
         errs[h] = (R.rel_err(r["X"], X), R.rel_err(r["x"], x))
@@ -42,12 +42,12 @@ def test_cosimulation_with_derivatives_converges_at_second_order(unzipdir):
     w, A_g, t_end = demo.W_S, 1e-4, 20.0
     errs, held = {}, {}
     for h in (4e-3, 2e-3, 1e-3):
-        r = demo.cosimulate(unzipdir, w, A_g, h, t_end, params={"A_e": p.A_e}, t_window=5.0,
+        r = demo.cosimulate(unzipdir, w, A_g, h, t_end, params={"A_e": p.A_e, "amplitude": "Fixed"}, t_window=5.0,
                             record=True, extrapolate=True)
         X, V, x, v = R.coupled_monolithic(p, demo.M_S, demo.C_S, demo.K_S, w, A_g, r["t"])
         errs[h] = (R.rel_err(r["X"], X), R.rel_err(r["x"], x))
         if h == 1e-3:
-            r0 = demo.cosimulate(unzipdir, w, A_g, h, t_end, params={"A_e": p.A_e}, t_window=5.0,
+            r0 = demo.cosimulate(unzipdir, w, A_g, h, t_end, params={"A_e": p.A_e, "amplitude": "Fixed"}, t_window=5.0,
                                  record=True)
             held = (R.rel_err(r0["X"], X), R.rel_err(r0["x"], x))
         print(f"h = {h}: with derivatives: structure {errs[h][0]:.2e}, sloshing {errs[h][1]:.2e}")

@@ -32,7 +32,7 @@ ENUMS = {
     "solver": {"DormandPrince45": 1, "RK4": 2},
     "model": {"Nonlinear": 2},
 }
-ENUM_DEFAULTS = {"model": "Nonlinear", "damping": "NSD", "amplitude": "Fixed",
+ENUM_DEFAULTS = {"model": "Nonlinear", "damping": "NSD", "amplitude": "Tracked",
                  "solver": "DormandPrince45"}
 
 
