@@ -96,6 +96,22 @@ impl Instance {
         }
     }
 
+    /// The damper's notice of implausible motion, to the host as a warning once per run.
+    #[cold]
+    #[inline(never)]
+    fn pass_notice(&mut self) -> Status {
+        let (time, a) = (self.time, self.values.get(vr::BASE_A));
+        let Some(notice) = self.sim.as_mut().and_then(|sim| sim.notice(a)) else {
+            return Status::Ok;
+        };
+        self.log(
+            Status::Warning,
+            "logStatusWarning",
+            &format!("fmi2DoStep to t = {time}: {notice}"),
+        );
+        Status::Warning
+    }
+
     /// Whether the host asked for every call to be logged.
     #[inline(always)]
     pub fn logs_calls(&self) -> bool {
@@ -282,10 +298,13 @@ impl Instance {
             .as_mut()
             .ok_or_else(|| refuse("fmi2DoStep: no simulation (not initialised)"))?;
         match sim.step(t, h, &inputs) {
-            Ok(_) => {
+            Ok(report) => {
                 self.time = t + h;
                 // Input derivatives describe one communication step.
                 self.a_derivatives = [0.0; 2];
+                if report.implausible {
+                    return Ok(self.pass_notice());
+                }
                 Ok(Status::Ok)
             }
             Err(e) => {

@@ -99,6 +99,16 @@ impl Common {
                 "depth ratio h/a = {r:.3} exceeds 0.15: the shallow-water model is outside its validity"
             ));
         }
+        // Tuned to buildings, a damper sloshes with a period of about 0.2 to 20 s; a period far
+        // outside that most likely means lengths in other units than metres.
+        let period = 2.0 * std::f64::consts::PI / self.tank.fundamental().omega;
+        if !(0.05..=60.0).contains(&period) {
+            warnings.push(format!(
+                "tank.length = {} m and tank.depth = {} m give a sloshing period of {period:.3} s, \
+                 far from any structure's: are the lengths in metres (not cm or mm)?",
+                self.tank.length, self.tank.depth
+            ));
+        }
         if self.x0.abs() > self.tank.length {
             return Err(format!(
                 "|slosh.x0| = {} m exceeds the tank length {} m",

@@ -32,6 +32,17 @@ pub struct Damper {
     /// loads.
     force: f64,
     sloshing: (f64, f64),
+    /// Whether the run has been told of implausible motion.
+    noticed: bool,
+}
+
+/// What a step of the damper reports besides its new state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Report {
+    pub stats: SolveStats,
+    /// The motion is implausible for a building (likely a unit mistake): [`Damper::notice`]
+    /// says why.
+    pub implausible: bool,
 }
 
 impl Damper {
@@ -74,6 +85,7 @@ impl Damper {
             amplitude,
             zeta,
             last_mean_force: None,
+            noticed: false,
         };
         Ok((damper, warnings))
     }
@@ -86,7 +98,7 @@ impl Damper {
     /// from `inputs` (held when the derivatives are 0). All or nothing: on error the damper is
     /// unchanged.
     #[inline]
-    pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<SolveStats, StepError> {
+    pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
         // Only a tracked amplitude moves the damping; a fixed one was applied in configure.
         match &self.tracker {
             None => self.advance(self.zeta, t, h, inputs),
@@ -106,23 +118,17 @@ impl Damper {
         t: f64,
         h: f64,
         inputs: &Inputs,
-    ) -> Result<SolveStats, StepError> {
-        let stats = self.advance(self.common.zeta(tracker.estimate()), t, h, inputs)?;
+    ) -> Result<Report, StepError> {
+        let report = self.advance(self.common.zeta(tracker.estimate()), t, h, inputs)?;
         self.amplitude = tracker.estimate();
         self.tracker = Some(tracker);
-        Ok(stats)
+        Ok(report)
     }
 
     /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker. Small
     /// (the models' steps are out of line), so inlined into both kinds of amplitude.
     #[inline(always)]
-    fn advance(
-        &mut self,
-        zeta: f64,
-        t: f64,
-        h: f64,
-        inputs: &Inputs,
-    ) -> Result<SolveStats, StepError> {
+    fn advance(&mut self, zeta: f64, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
         // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
         // input, and (t + h) - t is not h in floating point.
         let step = Interval {
@@ -149,7 +155,43 @@ impl Damper {
             self.force
         });
         self.zeta = zeta;
-        Ok(stepped.stats)
+        // Far beyond the walls (twice their distance): most likely a unit mistake, in the input
+        // or the tank, which `notice` explains. An implausible input drives the sloshing there
+        // within a step or two.
+        let implausible = self.sloshing.0.abs() > self.common.tank.length;
+        Ok(Report {
+            stats: stepped.stats,
+            implausible,
+        })
+    }
+
+    /// Why the last step's motion is implausible, under base acceleration `a`: the first time
+    /// in a run; None after that.
+    #[cold]
+    #[inline(never)]
+    pub fn notice(&mut self, a: f64) -> Option<String> {
+        // More than any floor of a building moves: 10 g.
+        const IMPLAUSIBLE_ACCELERATION: f64 = 10.0 * 9.81;
+        if self.noticed {
+            return None;
+        }
+        self.noticed = true;
+        let length = self.common.tank.length;
+        let x = self.sloshing.0;
+        Some(if a.abs() > IMPLAUSIBLE_ACCELERATION {
+            format!(
+                "base.a = {a} m/s^2 is {:.0} g, implausible for a building floor: is it given in \
+                 mm/s^2 or in g instead of m/s^2?",
+                a.abs() / 9.81
+            )
+        } else {
+            format!(
+                "slosh.x = {x:.3} m in a tank {length} m long (walls at +-{:.3} m): the sloshing \
+                 is far beyond the walls, where no model of this FMU holds. Is base.a in m/s^2 \
+                 (not mm/s^2 or g), and are the tank's lengths in metres?",
+                0.5 * length
+            )
+        })
     }
 
     /// The output `which` now.

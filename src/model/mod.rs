@@ -15,7 +15,7 @@ pub mod nonlinear;
 pub mod slamming;
 
 pub use common::{AmplitudeSource, Common, Derived};
-pub use damper::Damper;
+pub use damper::{Damper, Report};
 pub use parameters::{Parameters, StartValues, choice};
 pub use registry::AnyModel;
 

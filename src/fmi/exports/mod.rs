@@ -48,10 +48,10 @@ fn guard(
 #[inline(never)]
 fn report(inst: &mut Instance, call: &Call, reply: Reply) -> fmi2Status {
     match reply {
-        // Carried out (a warning says why itself): traced when the host asked for logCalls.
+        // Carried out (a warning has said why itself): traced when the host asked for logCalls.
         Ok(status) => {
             if inst.logs_calls() {
-                inst.log(status, "logCalls", call.name);
+                inst.log(Status::Ok, "logCalls", call.name);
             }
             status as fmi2Status
         }

@@ -196,7 +196,7 @@ fn the_force_kept_with_the_state_is_the_states_force() {
                 v: -0.3 / 5.6 * (5.6 * t).cos(),
                 ..Inputs::default()
             };
-            let stats = sim.step(t, 0.01, &inputs).expect("step");
+            let stats = sim.step(t, 0.01, &inputs).expect("step").stats;
             same(&sim, &format!("step {k}"));
             zetas.push(sim.zeta);
             // The exact linear step of model = Auto evaluates nothing.
@@ -433,4 +433,46 @@ fn every_declared_parameter_is_read() {
     // The Integer aliases of the enumerations are the FMI layer's to resolve (fmi::params).
     unread.retain(|name| !name.ends_with("_id"));
     assert!(unread.is_empty(), "declared but never read: {unread:?}");
+}
+
+/// Likely unit mistakes are noticed once per run: base.a in mm/s^2 (the sloshing then goes far
+/// beyond the walls), base.a absurdly large, and tank lengths in centimetres (a configuration
+/// warning). An ordinary run near resonance, up to the walls, is not.
+#[test]
+fn unit_mistakes_are_noticed_once() {
+    let w = 5.6;
+    let run = |p: &StartValues, scale: f64| {
+        let mut sim = damper(p);
+        let mut notices = vec![];
+        for k in 0..3000 {
+            let t = f64::from(k) * 0.01;
+            let inputs = held(-scale * w * w * 0.005 * (w * t).sin());
+            match sim.step(t, 0.01, &inputs) {
+                Ok(report) if report.implausible => notices.extend(sim.notice(inputs.a)),
+                Ok(_) => {}
+                Err(_) => break,
+            }
+        }
+        notices
+    };
+    // 5 mm of base motion at resonance: the sloshing reaches the walls, and that is physics.
+    let ordinary = run(&defaults(), 1.0);
+    assert!(ordinary.is_empty(), "{ordinary:?}");
+    // The same in mm/s^2: 1000 times the acceleration.
+    let millimetres = run(&defaults(), 1000.0);
+    assert_eq!(millimetres.len(), 1, "{millimetres:?}");
+    assert!(millimetres[0].contains("mm/s^2"), "{}", millimetres[0]);
+    // Linear, so that nothing bounds the sloshing but the runaway check.
+    let linear = defaults().with(vr::MODEL, LINEAR);
+    let beyond = run(&linear, 30.0);
+    assert_eq!(beyond.len(), 1, "{beyond:?}");
+    assert!(beyond[0].contains("beyond the walls"), "{}", beyond[0]);
+    let (_, warnings) =
+        Damper::configure(&defaults().with(vr::TANK_LENGTH, 25.0)).expect("simulable");
+    assert!(
+        warnings.iter().any(|w| w.contains("metres")),
+        "a 25 m tank 21 mm deep: {warnings:?}"
+    );
+    let (_, warnings) = Damper::configure(&defaults()).expect("defaults");
+    assert!(warnings.is_empty(), "{warnings:?}");
 }
