@@ -4,7 +4,7 @@
 //! nonlinearity. Statistical linearisation instead solves sigma^2 = D_n / (2c K_R(sigma)).
 
 use super::linearisation::stiffness_random;
-use crate::physics::nonlinear::PowerLaw;
+use crate::physics::power::PowerLaw;
 
 /// Exact stationary variances (displacement, velocity).
 pub fn exact_variances(law: &PowerLaw, c: f64, d_n: f64) -> (f64, f64) {
