@@ -401,7 +401,7 @@ def git_info():
         head = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
                               capture_output=True, text=True).stdout.strip()
         dirty = subprocess.run(["git", "-C", str(REPO), "status", "--porcelain", "--", "src",
-                                "Cargo.toml", "modelDescription", "build.rs", "tools"],
+                                "Cargo.toml", "modelDescription", "build", "tools"],
                                capture_output=True, text=True).stdout.strip()
         return head + (" + uncommitted changes in src/Cargo.toml/modelDescription" if dirty else "")
     except OSError:
