@@ -348,7 +348,7 @@ fn too_many_substeps_is_a_discard_that_keeps_the_state() {
 }
 
 /// The per-step calls have fast paths; they must step aside when the host asks for every
-/// call to be logged, and refuse exactly as before.
+/// call to be logged, and refuse with the statuses and reasons of the general path.
 #[test]
 fn per_step_calls_are_logged_when_asked_and_refused_as_before() {
     let mut inst = Instance::new("per-step-calls");
@@ -380,7 +380,7 @@ fn per_step_calls_are_logged_when_asked_and_refused_as_before() {
     assert_eq!(count(&inst, "fmi2GetReal"), 1, "{:?}", inst.logs());
     assert_eq!(count(&inst, "fmi2DoStep"), 1, "{:?}", inst.logs());
 
-    // Refusals while stepping, logging off again: the same statuses and reasons as ever.
+    // Refusals while stepping, logging off again: the statuses and reasons of the general path.
     assert_eq!(
         unsafe { lib.fmi2SetDebugLogging(inst.c, 0, 0, std::ptr::null()) },
         OK
