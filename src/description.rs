@@ -1,5 +1,5 @@
-//! The model description as Rust, shared by the FMI layer and the models: what build.rs
-//! generates from modelDescription/modelDescription.xml, and the types it uses:
+//! The model description as Rust, shared by the FMI layer and the models: what the build
+//! script (build/) generates from modelDescription/modelDescription.xml, and the types it uses:
 //! - `VARIABLES` (the variable table) and `vr::*` (value references, `.` becomes `_`);
 //! - one enum per enumeration type, named after it with `Item` appended (`ModelKindItem`,
 //!   `DampingLawItem`, `AmplitudeModeItem`, `SolverMethodItem`): the XML's items as variants with

@@ -3,7 +3,7 @@
 Same equations as TLD.fmu's Nonlinear model with a constant damping ratio (Eq 2.11 with the
 power law Phi of Eq 2.13), base acceleration held over each communication step, classical RK4
 with equal substeps no longer than `fixed_step`. Geometry (omega_f, sloshing mass) from Eqs 2.1/2.2.
-Built by `pythonfmu build -f tld_py.py` (bench/python/bench.py does it).
+Built by `pythonfmu build -f tld_py.py` (bench/python/workprec/baselines.py does it).
 """
 import math
 

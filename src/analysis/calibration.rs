@@ -7,7 +7,7 @@
 //! by Nelder-Mead on the squared relative residuals.
 
 use super::harmonic::HarmonicBalance;
-use crate::physics::nonlinear::PowerLaw;
+use crate::physics::power::PowerLaw;
 
 /// One measured point.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -14,7 +14,7 @@
 //! others not; for large eta a detached branch may appear beyond the walls.
 
 use super::linearisation::stiffness_harmonic;
-use crate::physics::nonlinear::PowerLaw;
+use crate::physics::power::PowerLaw;
 
 /// One point of a response curve.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -4,7 +4,7 @@
 //! c_R(eta) sigma^(2eta-2); lambda = psi = 0 in both.
 
 use super::ln_gamma;
-use crate::physics::nonlinear::PowerLaw;
+use crate::physics::power::PowerLaw;
 
 /// c_H(eta) = 2 Gamma(eta + 1/2) / (sqrt(pi) Gamma(eta + 1)); 2 C(2eta, eta)/4^eta for integers.
 pub fn c_harmonic(eta: f64) -> f64 {

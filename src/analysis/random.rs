@@ -4,7 +4,7 @@
 //! nonlinearity. Statistical linearisation instead solves sigma^2 = D_n / (2c K_R(sigma)).
 
 use super::linearisation::stiffness_random;
-use crate::physics::nonlinear::PowerLaw;
+use crate::physics::power::PowerLaw;
 
 /// Exact stationary variances (displacement, velocity).
 pub fn exact_variances(law: &PowerLaw, c: f64, d_n: f64) -> (f64, f64) {
@@ -63,9 +63,10 @@ mod tests {
         assert!((linearised_variance(&law, c, d) / want - 1.0).abs() < 1e-12);
     }
 
-    /// Statistical linearisation is only approximate (MODEL.md section 4), and more so for
-    /// larger eta: at 2 sigma_x / a of about 0.5, measured 13.7 % below the exact variance for
-    /// eta = 3, a few percent for eta = 2. Never equal.
+    /// Statistical linearisation is only approximate (MODEL.md section 4): it takes x as
+    /// Gaussian, whereas the exact density exp(-(2c/D_n) U(x)) of the module's header is not, and
+    /// departs further from one the faster U grows, i.e. the larger eta. Hence the looser bound
+    /// for eta = 3 than for eta = 2 (at 2 sigma_x / a of about 0.5), and never equality.
     #[test]
     fn linearisation_is_close_but_not_exact() {
         for (eta, max_off) in [(2.0, 0.05), (3.0, 0.2)] {

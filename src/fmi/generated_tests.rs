@@ -1,4 +1,4 @@
-//! The items build.rs generates, checked against modelDescription.xml read here by a scanner of
+//! The items the build script (build/) generates, checked against modelDescription.xml read here by a scanner of
 //! its own: a slip in the generator (an item dropped, a value or name swapped, a category or
 //! limit lost) fails these tests instead of reaching the FMU.
 

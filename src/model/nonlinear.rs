@@ -8,7 +8,8 @@ use super::{
 };
 use crate::description::{SolverMethodItem, vr};
 use crate::physics::base::BaseAcceleration;
-use crate::physics::nonlinear::{CompiledTld, NonlinearTld, PowerLaw, RhsJob, state};
+use crate::physics::nonlinear::{CompiledTld, NonlinearTld, RhsJob, state};
+use crate::physics::power::PowerLaw;
 use crate::solver::{
     Auto, Dop853, Dopri5, ExpRk4, OscillatorSplit, Rk4, Rk5, Rk8, Sdirk4, SolveError, SolveStats,
 };

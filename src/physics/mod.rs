@@ -7,4 +7,5 @@ pub mod geometry;
 pub mod laws;
 pub mod linear;
 pub mod nonlinear;
+pub mod power;
 pub mod slamming;

@@ -27,8 +27,8 @@ struct Flows {
 
 impl Flows {
     /// The flows of `f`'s linear part for key (h, w2, c). Out of line and cold: inlined, the
-    /// propagator's exp, sin and cos were computed ahead of the cache check on every step
-    /// (the compiler may speculate calls it knows to be pure).
+    /// propagator's exp, sin and cos could be hoisted ahead of the cache check (the compiler
+    /// may speculate calls it knows to be pure) and paid on every step, not on a miss only.
     #[cold]
     #[inline(never)]
     fn of<const N: usize, F: OscillatorSplit<N>>(f: &F, key: [f64; 3]) -> Self {

@@ -191,3 +191,52 @@ impl Drop for Instance {
         unsafe { self.lib.fmi2FreeInstance(self.c) }
     }
 }
+
+/// The instance's FMU state (fmi2GetFMUstate), which the caller frees.
+pub fn get_state(inst: &Instance) -> fmi_sys::fmi2::fmi2FMUstate {
+    let mut s: fmi_sys::fmi2::fmi2FMUstate = std::ptr::null_mut();
+    assert_eq!(
+        unsafe { inst.lib.fmi2GetFMUstate(inst.c, &mut s) },
+        OK,
+        "{:?}",
+        inst.logs()
+    );
+    assert!(!s.is_null());
+    s
+}
+
+/// The serialised bytes of state `s` (fmi2SerializedFMUstateSize, fmi2SerializeFMUstate).
+pub fn serialize(inst: &Instance, s: fmi_sys::fmi2::fmi2FMUstate) -> Vec<u8> {
+    let mut n = 0usize;
+    unsafe {
+        assert_eq!(inst.lib.fmi2SerializedFMUstateSize(inst.c, s, &mut n), OK);
+        let mut bytes = vec![0u8; n];
+        assert_eq!(
+            inst.lib
+                .fmi2SerializeFMUstate(inst.c, s, bytes.as_mut_ptr() as *mut _, n),
+            OK
+        );
+        bytes
+    }
+}
+
+/// fmi2DeSerializeFMUstate of `bytes`: its status and the new state (null when refused).
+pub fn deserialize(inst: &Instance, bytes: &[u8]) -> (u32, fmi_sys::fmi2::fmi2FMUstate) {
+    let mut s: fmi_sys::fmi2::fmi2FMUstate = std::ptr::null_mut();
+    let status = unsafe {
+        inst.lib
+            .fmi2DeSerializeFMUstate(inst.c, bytes.as_ptr() as *const _, bytes.len(), &mut s)
+    };
+    (status, s)
+}
+
+/// An instance out of initialisation mode with the Tracked amplitude estimate (amplitude = 2),
+/// whose state holds more than x and v.
+pub fn tracked(name: &str) -> Instance {
+    let inst = Instance::new(name);
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.set_integer(vr::AMPLITUDE, 2), OK);
+    assert_eq!(inst.exit(), OK);
+    inst
+}

@@ -1,6 +1,6 @@
 //! tld-bench: native work-precision benchmark host for TLD.fmu.
 //!
-//! Usage: `tld-bench JOBFILE`. The job file (written by bench/python/bench.py) is read line by
+//! Usage: `tld-bench JOBFILE`. The job file (written by bench/python/workprec/native.py) is read line by
 //! line; settings lines configure, `run` lines execute:
 //!
 //! ```text
@@ -124,8 +124,8 @@ type RunResult = Result<(u128, Vec<f64>, Vec<f64>), (usize, String)>;
 /// The co-simulation master of the coupled scene (explicit, force held over the step):
 /// at t_k, a_tank = (F_k - C V_k - K X_k)/(M + m0) is given to the damper as base.a, the damper
 /// steps, and the structure is advanced over the same step by RK4 (`sub` substeps) with F_k
-/// held and the ground acceleration evaluated where RK4 needs it. bench.py's reference master
-/// performs the same operations in the same order.
+/// held and the ground acceleration evaluated where RK4 needs it. The reference master
+/// (`coupled_master` in python/tld_fmu/scenes.py) performs the same operations in the same order.
 fn run_coupled<D: Damper>(d: &mut D, s: &Coupled, m0: f64, dt: f64) -> RunResult {
     let n = s.n;
     let mut xs = vec![0.0; n + 1];

@@ -14,7 +14,7 @@
 use tld_fmu::analysis::coupled::Coupled;
 use tld_fmu::analysis::harmonic::HarmonicBalance;
 use tld_fmu::physics::geometry::Tank;
-use tld_fmu::physics::nonlinear::PowerLaw;
+use tld_fmu::physics::power::PowerLaw;
 
 fn main() {
     if let Err(e) = run() {

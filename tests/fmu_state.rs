@@ -1,0 +1,190 @@
+//! FMU states through the C entry points of the built library: get/set round trips, serialised
+//! states restored in another instance (the S^2 model's impact state included), and buffers
+//! that are not states of this FMU refused.
+
+mod common;
+
+use common::*;
+use tld_fmu::fmi::vars::vr;
+
+/// Get a state, run on, set it back, run the same again: bit-identical.
+#[test]
+fn fmu_state_round_trip_is_bit_identical() {
+    let mut inst = tracked("state-roundtrip");
+    inst.run_harmonic(150, 0.01);
+    let s = get_state(&inst);
+    let t_saved = inst.time;
+    let first = inst.run_harmonic(200, 0.01);
+    let first_estimate = inst.get_real(vr::A_E_ESTIMATE).1;
+    assert_eq!(unsafe { inst.lib.fmi2SetFMUstate(inst.c, s) }, OK);
+    inst.time = t_saved;
+    let again = inst.run_harmonic(200, 0.01);
+    assert_eq!(first.to_bits(), again.to_bits());
+    assert_eq!(
+        first_estimate.to_bits(),
+        inst.get_real(vr::A_E_ESTIMATE).1.to_bits()
+    );
+    // Overwriting an existing state in place, then freeing it (twice: the slot is nulled).
+    let mut s2 = s;
+    unsafe {
+        assert_eq!(inst.lib.fmi2GetFMUstate(inst.c, &mut s2), OK);
+        assert_eq!(s2, s, "the host's state is reused");
+        assert_eq!(inst.lib.fmi2FreeFMUstate(inst.c, &mut s2), OK);
+        assert!(s2.is_null());
+        assert_eq!(inst.lib.fmi2FreeFMUstate(inst.c, &mut s2), OK);
+    }
+}
+
+/// A serialised state restores in another instance that never ran, and continues exactly as
+/// the uninterrupted run.
+#[test]
+fn serialized_state_restores_in_another_instance() {
+    let mut a = tracked("state-source");
+    a.run_harmonic(120, 0.01);
+    let s = get_state(&a);
+    let bytes = serialize(&a, s);
+    let t_saved = a.time;
+    let uninterrupted = a.run_harmonic(180, 0.01);
+    let mut b = Instance::new("state-target");
+    let (status, restored) = deserialize(&b, &bytes);
+    assert_eq!(status, OK, "{:?}", b.logs());
+    assert_eq!(
+        unsafe { b.lib.fmi2SetFMUstate(b.c, restored) },
+        OK,
+        "{:?}",
+        b.logs()
+    );
+    b.time = t_saved;
+    let continued = b.run_harmonic(180, 0.01);
+    assert_eq!(uninterrupted.to_bits(), continued.to_bits());
+    // A state taken before initialisation brings an initialised instance back there.
+    let fresh = Instance::new("state-early");
+    assert_eq!(fresh.setup(), OK);
+    assert_eq!(fresh.enter(), OK);
+    let early = get_state(&fresh);
+    assert_eq!(unsafe { b.lib.fmi2SetFMUstate(b.c, early) }, OK);
+    assert_eq!(b.exit(), OK, "back in initialisation mode");
+    unsafe {
+        let mut s = s;
+        let mut restored = restored;
+        let mut early = early;
+        a.lib.fmi2FreeFMUstate(a.c, &mut s);
+        b.lib.fmi2FreeFMUstate(b.c, &mut restored);
+        fresh.lib.fmi2FreeFMUstate(fresh.c, &mut early);
+    }
+}
+
+/// Truncated, corrupted, foreign and wrong-version buffers are refused with a reason, and the
+/// instance is unharmed.
+#[test]
+fn bad_serialized_states_are_refused() {
+    let mut inst = Instance::new("state-bad");
+    inst.initialise();
+    inst.run_harmonic(50, 0.01);
+    let s = get_state(&inst);
+    let bytes = serialize(&inst, s);
+    let reference = {
+        let mut clean = Instance::new("state-bad-clean");
+        clean.initialise();
+        clean.run_harmonic(50, 0.01);
+        clean.run_harmonic(50, 0.01)
+    };
+    let mut refused = 0;
+    for len in 0..bytes.len() {
+        assert_eq!(
+            deserialize(&inst, &bytes[..len]).0,
+            ERROR,
+            "truncated to {len}"
+        );
+        refused += 1;
+    }
+    for at in 0..bytes.len() {
+        let mut bad = bytes.clone();
+        bad[at] ^= 0x5a;
+        assert_eq!(deserialize(&inst, &bad).0, ERROR, "byte {at} flipped");
+        refused += 1;
+    }
+    let mut longer = bytes.clone();
+    longer.push(0);
+    assert_eq!(deserialize(&inst, &longer).0, ERROR, "trailing byte");
+    let foreign: Vec<u8> = (0..bytes.len()).map(|i| (i * 37 % 251) as u8).collect();
+    assert_eq!(deserialize(&inst, &foreign).0, ERROR, "foreign bytes");
+    // A well-formed buffer of another format version (checksum recomputed).
+    let mut other = bytes[..bytes.len() - 8].to_vec();
+    other[4] = 2;
+    let sum = other.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    other.extend_from_slice(&sum.to_le_bytes());
+    assert_eq!(deserialize(&inst, &other).0, ERROR, "version 2");
+    let logs = inst.logs();
+    assert!(logs.iter().any(|m| m.contains("truncated")), "{logs:?}");
+    assert!(logs.iter().any(|m| m.contains("checksum")), "{logs:?}");
+    assert!(logs.iter().any(|m| m.contains("version 2")), "{logs:?}");
+    assert!(refused > 2 * 100);
+    unsafe {
+        // Pointers that are not states of ours.
+        let mut junk = 7u64;
+        assert_eq!(
+            inst.lib
+                .fmi2SetFMUstate(inst.c, &mut junk as *mut u64 as *mut _),
+            ERROR
+        );
+        assert_eq!(
+            inst.lib.fmi2SetFMUstate(inst.c, std::ptr::null_mut()),
+            ERROR
+        );
+        let mut s = s;
+        inst.lib.fmi2FreeFMUstate(inst.c, &mut s);
+    }
+    assert_eq!(inst.run_harmonic(50, 0.01).to_bits(), reference.to_bits());
+}
+
+/// The S^2 model's state (impact mass position, velocity, wall contact, count) survives a
+/// serialised round trip into another instance, bit for bit.
+#[test]
+fn slamming_state_round_trip() {
+    let start = |name: &str| {
+        let inst = Instance::new(name);
+        assert_eq!(inst.setup(), OK);
+        assert_eq!(inst.enter(), OK);
+        assert_eq!(inst.set_integer(vr::MODEL, 3), OK);
+        assert_eq!(inst.set_real(vr::SLAMMING_OMEGA, 0.9), OK);
+        assert_eq!(inst.exit(), OK);
+        inst
+    };
+    let mut a = start("s2-source");
+    a.run_harmonic(300, 0.01);
+    let s = get_state(&a);
+    let bytes = serialize(&a, s);
+    let t_saved = a.time;
+    let uninterrupted = a.run_harmonic(300, 0.01);
+    let impacts = |i: &Instance| {
+        let mut n = 0;
+        unsafe { i.lib.fmi2GetInteger(i.c, &vr::IMPACTS, 1, &mut n) };
+        n
+    };
+    let n_a = impacts(&a);
+    assert!(n_a >= 1, "the scene must slam: {n_a} impacts");
+    let mut b = start("s2-target");
+    let (status, restored) = deserialize(&b, &bytes);
+    assert_eq!(status, OK, "{:?}", b.logs());
+    assert_eq!(
+        unsafe { b.lib.fmi2SetFMUstate(b.c, restored) },
+        OK,
+        "{:?}",
+        b.logs()
+    );
+    b.time = t_saved;
+    assert_eq!(b.run_harmonic(300, 0.01).to_bits(), uninterrupted.to_bits());
+    assert_eq!(impacts(&b), n_a);
+    assert_eq!(
+        b.get_real(vr::IMPACT_Z).1.to_bits(),
+        a.get_real(vr::IMPACT_Z).1.to_bits()
+    );
+    unsafe {
+        let (mut s, mut r) = (s, restored);
+        a.lib.fmi2FreeFMUstate(a.c, &mut s);
+        b.lib.fmi2FreeFMUstate(b.c, &mut r);
+    }
+}
