@@ -1,6 +1,6 @@
 """Independent reference solutions for the TLD.fmu tests.
 
-Written from the equations in shared/spec/MODEL.md and the FMU contract (modelDescription.xml,
+Written from the equations in docs/MODEL.md and the FMU contract (modelDescription.xml,
 whose enumeration values it reads through tld_fmu.contract), sharing no code with the Rust FMU.
 Nothing here loads the FMU.
 

@@ -66,6 +66,7 @@ import numpy as np
 import pytest
 
 from conftest import MODELS_APART
+from ecos_unzip import write_standin
 from tld_fmu.contract import item, items
 from host_scene import (
     DT, N, OUTPUTS, RTOL, T_END, base_acceleration, bitwise, compare, rel_diff, run_fmpy,
@@ -90,23 +91,6 @@ EcosLib.set_log_level("warn")   # proxyfmu logs every boot at "info"
 
 INSTANCE = "tld"
 
-_UNZIP_STANDIN = '''#!{python}
-"""Stand-in for `unzip -o ZIP -d DIR` (all Ecos runs), written by test_hosts_ecospy.py."""
-import sys, zipfile
-args, dest, files = sys.argv[1:], ".", []
-i = 0
-while i < len(args):
-    if args[i] == "-d":
-        dest = args[i + 1]; i += 2
-    elif args[i].startswith("-"):
-        i += 1
-    else:
-        files.append(args[i]); i += 1
-with zipfile.ZipFile(files[0]) as z:
-    z.extractall(dest)
-'''
-
-
 @pytest.fixture(scope="module", autouse=True)
 def ecos_unzip(tmp_path_factory):
     """Ecos needs `unzip` on PATH (see the module docstring); provide one if there is none."""
@@ -114,9 +98,7 @@ def ecos_unzip(tmp_path_factory):
         yield "system"
         return
     d = tmp_path_factory.mktemp("ecos_unzip")
-    exe = d / "unzip"
-    exe.write_text(_UNZIP_STANDIN.format(python=sys.executable))
-    exe.chmod(exe.stat().st_mode | stat.S_IXUSR | stat.S_IXGRP | stat.S_IXOTH)
+    write_standin(d)
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("PATH", f"{d}{os.pathsep}{os.environ.get('PATH', '')}")
         yield "stand-in"
