@@ -7,7 +7,7 @@ use super::status::{Refusal, Reply, Status, refuse};
 use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, finite, index_of, vr};
 use crate::model::Output;
 
-use super::calls::{Call, Phase};
+use super::calls::Phase;
 
 /// The variable behind `vr`.
 fn variable(vr: u32, function: &str) -> Result<(usize, &'static Variable), Refusal> {
@@ -52,16 +52,9 @@ fn typed_variable(
 }
 
 impl Instance {
-    /// Whether `call` would be carried out without a word to the logger: allowed in this phase,
-    /// and calls not logged. The condition for the early exits of the per-step calls.
-    #[inline(always)]
-    pub fn quiet(&self, call: &Call) -> bool {
-        self.phase.bit() & call.allowed != 0 && !self.logs_calls()
-    }
-
     /// The value of `r` read as `ty` if it is a load: a stored value, or an output a master
     /// reads after every step of a running simulation. None for anything else, which
-    /// [`Instance::value_in_full`] answers.
+    /// [`Instance::value_in_full`] answers out of line.
     #[inline(always)]
     fn loaded(&self, r: u32, ty: VarType) -> Option<f64> {
         match source_of(r, ty) {
@@ -69,19 +62,6 @@ impl Instance {
             Source::Output(which) => self.sim.as_ref()?.per_step_output(which),
             _ => None,
         }
-    }
-
-    /// Every value of `vrs` into `out` if each is a load (see [`Instance::loaded`]); false as soon
-    /// as one is not (what was written then does not count).
-    #[inline(always)]
-    pub fn load_all<T>(&self, vrs: &[u32], out: &mut [T], ty: VarType, to: fn(f64) -> T) -> bool {
-        for (slot, &r) in out.iter_mut().zip(vrs) {
-            match self.loaded(r, ty) {
-                Some(v) => *slot = to(v),
-                None => return false,
-            }
-        }
-        true
     }
 
     /// Values of the variables `vrs` of type `ty` into `out`, converted by `to`. The instance's
@@ -148,6 +128,13 @@ impl Instance {
         function: &str,
         from: fn(T) -> f64,
     ) -> Reply {
+        // One variable (an input per step, the usual call): checked and set in one pass.
+        if let ([r], [v]) = (vrs, values) {
+            let v = from(*v);
+            let index = self.check_set(*r, v, ty, function)?;
+            self.put(*r, index, v);
+            return Ok(Status::Ok);
+        }
         for (&r, &v) in vrs.iter().zip(values) {
             self.check_set(r, from(v), ty, function)?;
         }
@@ -159,19 +146,8 @@ impl Instance {
         Ok(Status::Ok)
     }
 
-    /// Set `r` to `value` if it is the per-step input: a Real input without bounds, which takes
-    /// any finite value (what [`Instance::check_set`] would accept, by one table look-up).
-    #[inline(always)]
-    pub fn set_input(&mut self, r: u32, value: f64, ty: VarType) -> bool {
-        match Self::free_input(r, value, ty) {
-            Some(index) => {
-                self.put(r, index, value);
-                true
-            }
-            None => false,
-        }
-    }
-
+    /// The position of `r` if it is a Real input without bounds (the per-step input) and
+    /// `value` finite: what the full check would accept, by one table look-up.
     #[inline(always)]
     fn free_input(r: u32, value: f64, ty: VarType) -> Option<usize> {
         match (ty, free_real_input(r)) {

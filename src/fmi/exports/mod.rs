@@ -92,32 +92,10 @@ fn bad_pointer(call: &Call, what: &str, n: usize) -> Refusal {
     ))
 }
 
-/// Whether `ptr` can be a host array of `n` elements (n > 0).
+/// Whether `ptr` can be a host array of `n` > 0 elements.
 #[inline(always)]
 fn valid_array<T>(ptr: *const T, n: usize) -> bool {
     !ptr.is_null() && ptr.is_aligned() && n <= isize::MAX as usize / size_of::<T>().max(1)
-}
-
-/// The host's arrays `vr` and `value` of `n` > 0 elements each, if they can be.
-///
-/// # Safety
-/// The host promises `n` elements behind each pointer.
-#[inline(always)]
-unsafe fn arrays<'a, T>(
-    vr: *const u32,
-    value: *mut T,
-    n: usize,
-) -> Option<(&'a [u32], &'a mut [T])> {
-    if n == 0 || !valid_array(vr, n) || !valid_array(value, n) {
-        return None;
-    }
-    // SAFETY: checked as `host_slice` checks, for arrays the host owns.
-    unsafe {
-        Some((
-            std::slice::from_raw_parts(vr, n),
-            std::slice::from_raw_parts_mut(value, n),
-        ))
-    }
 }
 
 /// A host array of `n` elements; `n` = 0 accepts a null pointer.

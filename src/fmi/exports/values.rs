@@ -3,7 +3,7 @@
 
 use fmi_sys::fmi2::*;
 
-use super::{arrays, guard, host_slice, host_slice_mut};
+use super::{guard, host_slice, host_slice_mut};
 use crate::fmi::calls::{self, Call};
 use crate::fmi::instance::Instance;
 use crate::fmi::status::{Reply, Status, refuse};
@@ -56,32 +56,9 @@ impl Access for Booleans {
     }
 }
 
-/// fmi2Get{Real,Integer,Boolean}. A running instance's per-step reads (stored values and the
-/// outputs read after every step, nothing to log) exit early, by loads only; everything else
-/// goes the whole way, [`get_in_full`], where the same loads are tried first.
+/// fmi2Get{Real,Integer,Boolean}.
 #[inline(always)]
 unsafe fn get<A: Access>(
-    c: fmi2Component,
-    call: &'static Call,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *mut A::Host,
-) -> fmi2Status {
-    // SAFETY: `c` as in `guard`; the arrays are the host's nvr elements, checked by `arrays`.
-    unsafe {
-        if let Some(inst) = Instance::from_ptr(c)
-            && inst.quiet(call)
-            && let Some((vrs, out)) = arrays(vr, value, nvr)
-            && inst.load_all(vrs, out, A::TYPE, A::to_host)
-        {
-            return Status::Ok as fmi2Status;
-        }
-        get_in_full::<A>(c, call, vr, nvr, value)
-    }
-}
-
-#[inline(never)]
-unsafe fn get_in_full<A: Access>(
     c: fmi2Component,
     call: &'static Call,
     vr: *const fmi2ValueReference,
@@ -100,33 +77,9 @@ unsafe fn get_in_full<A: Access>(
     })
 }
 
-/// fmi2Set{Real,Integer,Boolean}. The per-step input (one unbounded Real input, nothing to log)
-/// exits early by one table look-up; everything else goes the whole way, [`set_in_full`], whose
-/// check begins with the same look-up.
+/// fmi2Set{Real,Integer,Boolean}.
 #[inline(always)]
 unsafe fn set<A: Access>(
-    c: fmi2Component,
-    call: &'static Call,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *const A::Host,
-) -> fmi2Status {
-    // SAFETY: as in `get`.
-    unsafe {
-        if let Some(inst) = Instance::from_ptr(c)
-            && inst.quiet(call)
-            && nvr == 1
-            && let Some((vrs, values)) = arrays(vr, value as *mut A::Host, 1)
-            && inst.set_input(vrs[0], A::from_host(values[0]), A::TYPE)
-        {
-            return Status::Ok as fmi2Status;
-        }
-        set_in_full::<A>(c, call, vr, nvr, value)
-    }
-}
-
-#[inline(never)]
-unsafe fn set_in_full<A: Access>(
     c: fmi2Component,
     call: &'static Call,
     vr: *const fmi2ValueReference,
