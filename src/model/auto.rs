@@ -7,7 +7,7 @@ use super::check_runaway;
 use super::nonlinear::{Nonlinear, Shortcut};
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
 use crate::description::vr;
-use crate::physics::linear::{Mode, ModeState};
+use crate::physics::linear::{ModalOscillator, ModeState};
 use crate::physics::nonlinear::{NonlinearTld, state};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -21,7 +21,7 @@ pub struct NonlinearAuto {
 struct LinearBelow {
     threshold: f64,
     /// The linear propagator (kept for its cached coefficients).
-    mode: Mode,
+    mode: ModalOscillator,
 }
 
 impl Shortcut for LinearBelow {
@@ -42,7 +42,7 @@ impl Shortcut for LinearBelow {
 #[inline(never)]
 fn linear_step(
     tld: &NonlinearTld,
-    (threshold, mode): (f64, &mut Mode),
+    (threshold, mode): (f64, &mut ModalOscillator),
     y: &[f64; state::DIM],
     step: &Interval,
 ) -> Option<Result<[f64; state::DIM], StepError>> {
@@ -79,7 +79,7 @@ impl Model for NonlinearAuto {
             t if t > 0.0 => t,
             _ => nonlinear.method.tolerance(),
         };
-        let mode = Mode::new(common.tank.fundamental().omega, start.zeta);
+        let mode = ModalOscillator::new(common.tank.fundamental().omega, start.zeta);
         Ok(NonlinearAuto {
             nonlinear,
             linear: LinearBelow { threshold, mode },

@@ -5,7 +5,7 @@ use super::check_runaway;
 use super::rates::{self, Oscillator};
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
 use crate::description::{limits, vr};
-use crate::physics::linear::{Mode, ModeState};
+use crate::physics::linear::{ModalOscillator, ModeState};
 
 /// Numbers saved after the modes' states: the integrator memory of the state format, unused.
 const CARRIED: usize = 3;
@@ -13,7 +13,7 @@ const CARRIED: usize = 3;
 /// One linear mode: its propagator, its modal mass (all tanks) and its state.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LinearMode {
-    pub mode: Mode,
+    pub mode: ModalOscillator,
     pub mass: f64,
     pub state: ModeState,
 }
@@ -98,7 +98,7 @@ impl Model for Linear {
                     (0.0, 0.0)
                 };
                 LinearMode {
-                    mode: Mode::new(m.omega, start.zeta),
+                    mode: ModalOscillator::new(m.omega, start.zeta),
                     mass: m.mass * tanks,
                     state: ModeState {
                         x,

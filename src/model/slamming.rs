@@ -9,7 +9,7 @@ use super::rates::{self, Oscillator};
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
 use crate::description::vr;
 use crate::physics::laws::nsd_kappa;
-use crate::physics::linear::{Mode, ModeState};
+use crate::physics::linear::{ModalOscillator, ModeState};
 use crate::physics::slamming::{SlamState, Slamming};
 
 /// Numbers of the impact mass's state in a saved state, and the unused integrator memory after.
@@ -57,7 +57,7 @@ impl Model for SloshingSlamming {
         };
         Ok(SloshingSlamming {
             sloshing: LinearMode {
-                mode: Mode::new(m1.omega / omega.sqrt(), start.zeta),
+                mode: ModalOscillator::new(m1.omega / omega.sqrt(), start.zeta),
                 mass: omega * m1.mass * tanks,
                 state: ModeState {
                     x: common.x0,

@@ -19,7 +19,7 @@ pub struct Tank {
 
 /// One linear sloshing mode: the mass that takes part in it and its natural circular frequency.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Mode {
+pub struct NaturalMode {
     pub mass: f64,
     pub omega: f64,
 }
@@ -45,18 +45,18 @@ impl Tank {
     }
 
     /// Mode n = 1, 2, ... (Eq 2.1 for the mass, Eq 2.2 for the frequency).
-    pub fn mode(&self, n: u32) -> Mode {
+    pub fn mode(&self, n: u32) -> NaturalMode {
         let k = f64::from(2 * n.max(1) - 1) * PI; // (2n-1) pi
         let r = self.depth_ratio();
         let th = (k * r).tanh();
-        Mode {
+        NaturalMode {
             mass: self.liquid_mass() * 8.0 * th / (k.powi(3) * r),
             omega: (self.g * k * th / self.length).sqrt(),
         }
     }
 
     /// The fundamental mode, the one the nonlinear model lumps the sloshing into.
-    pub fn fundamental(&self) -> Mode {
+    pub fn fundamental(&self) -> NaturalMode {
         self.mode(1)
     }
 }

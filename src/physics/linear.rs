@@ -5,11 +5,11 @@
 
 use super::base::BaseAcceleration;
 
-/// One mode's exact propagator: x(s) = C(s) x0 + S(s) (v0 + sigma x0) for the free motion,
+/// One mode as a damped oscillator with its exact propagator: x(s) = C(s) x0 + S(s) (v0 + sigma x0) for the free motion,
 /// with sigma = zeta omega, C = e^(-sigma s) cos(mu s), S = e^(-sigma s) sin(mu s)/mu and
 /// mu^2 = omega^2 - sigma^2 (cosh/sinh when overdamped; the limits when critically damped).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Mode {
+pub struct ModalOscillator {
     pub omega: f64,
     pub zeta: f64,
     /// (h, zeta, C(h), S(h)) of the last step: communication steps are usually all alike, and
@@ -28,7 +28,7 @@ pub struct ModeState {
     pub dissipated: f64,
 }
 
-/// (C(s), S(s)) of the free motion of x'' + 2 sigma x' + w2 x = 0 (see [`Mode`]):
+/// (C(s), S(s)) of the free motion of x'' + 2 sigma x' + w2 x = 0 (see [`ModalOscillator`]):
 /// x(s) = C x0 + S (v0 + sigma x0), v(s) = C v0 - S (w2 x0 + sigma v0).
 pub fn free_motion(w2: f64, sigma: f64, s: f64) -> (f64, f64) {
     let m = FreeMotion::new(w2, sigma, s);
@@ -96,9 +96,9 @@ impl FreeMotion {
     }
 }
 
-impl Mode {
+impl ModalOscillator {
     pub fn new(omega: f64, zeta: f64) -> Self {
-        Mode {
+        ModalOscillator {
             omega,
             zeta,
             free_cache: (f64::NAN, f64::NAN, 0.0, 0.0),
@@ -195,7 +195,7 @@ mod tests {
     /// Free decay against the textbook closed form, over many steps of any size.
     #[test]
     fn free_decay_is_exact() {
-        let mut m = Mode::new(5.6389, 0.02);
+        let mut m = ModalOscillator::new(5.6389, 0.02);
         let wd = m.omega * (1.0 - m.zeta * m.zeta).sqrt();
         for h in [1e-4, 0.01, 0.3, 2.0] {
             let mut s = ModeState {
@@ -218,7 +218,7 @@ mod tests {
     #[test]
     fn overdamped_and_critical_modes() {
         for zeta in [1.0, 1.0 + 1e-9, 2.5] {
-            let mut m = Mode::new(3.0, zeta);
+            let mut m = ModalOscillator::new(3.0, zeta);
             let mut s = ModeState {
                 x: 0.02,
                 v: -0.1,
@@ -254,7 +254,7 @@ mod tests {
         let k = (sigma * sigma - omega * omega).sqrt();
         let (a, b) = (omega * omega / (sigma + k), sigma + k);
         for h in [1.0, 3.0, 15.0] {
-            let mut m = Mode::new(omega, zeta);
+            let mut m = ModalOscillator::new(omega, zeta);
             let mut s = ModeState {
                 x: 0.01,
                 ..Default::default()
@@ -279,7 +279,7 @@ mod tests {
     /// the energy exchanged against its quadrature.
     #[test]
     fn polynomial_input_and_energies() {
-        let mut m = Mode::new(4.0, 0.05);
+        let mut m = ModalOscillator::new(4.0, 0.05);
         let base = BaseAcceleration {
             t0: 0.0,
             a: [0.3, -0.8, 1.1],
