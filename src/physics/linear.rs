@@ -5,9 +5,10 @@
 
 use super::base::BaseAcceleration;
 
-/// One mode as a damped oscillator with its exact propagator: x(s) = C(s) x0 + S(s) (v0 + sigma x0) for the free motion,
-/// with sigma = zeta omega, C = e^(-sigma s) cos(mu s), S = e^(-sigma s) sin(mu s)/mu and
-/// mu^2 = omega^2 - sigma^2 (cosh/sinh when overdamped; the limits when critically damped).
+/// One mode as a damped oscillator with its exact propagator: for the free motion
+/// x(s) = C(s) x0 + S(s) (v0 + sigma x0), with sigma = zeta omega, C = e^(-sigma s) cos(mu s),
+/// S = e^(-sigma s) sin(mu s)/mu and mu^2 = omega^2 - sigma^2 (cosh/sinh when overdamped; the
+/// limits when critically damped).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModalOscillator {
     pub omega: f64,
