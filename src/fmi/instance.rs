@@ -8,7 +8,7 @@ use super::calls::{Call, Phase};
 use super::logger::Logger;
 use super::params::{Configuration, Values};
 use super::status::{Refusal, Reply, Status, refuse};
-use super::vars::{LOG_CATEGORIES, VARIABLES, finite, index_of, vr};
+use super::vars::{LOG_CATEGORIES, VARIABLES, finite, index_of, log_category, vr};
 use crate::model::{Damper, StepError};
 use crate::solver::SolveError;
 
@@ -106,7 +106,7 @@ impl Instance {
         };
         self.log(
             Status::Warning,
-            "logStatusWarning",
+            log_category::LOG_STATUS_WARNING,
             &format!("fmi2DoStep to t = {time}: {notice}"),
         );
         Status::Warning
@@ -136,8 +136,8 @@ impl Instance {
         }
         for c in categories {
             match c.as_str() {
-                "logCalls" => calls = on,
-                "logStatusError" | "logStatusWarning" => {}
+                log_category::LOG_CALLS => calls = on,
+                log_category::LOG_STATUS_ERROR | log_category::LOG_STATUS_WARNING => {}
                 other => unknown.push(other.chars().take(64).collect::<String>()),
             }
         }
@@ -148,7 +148,7 @@ impl Instance {
         } else {
             self.log(
                 Status::Warning,
-                "logStatusWarning",
+                log_category::LOG_STATUS_WARNING,
                 &format!(
                     "fmi2SetDebugLogging: unknown log categories {unknown:?} ignored (known: {})",
                     LOG_CATEGORIES.join(", ")
@@ -209,7 +209,7 @@ impl Instance {
         self.sim = Some(sim);
         self.phase = Phase::StepComplete;
         for w in &warnings {
-            self.log(Status::Warning, "logStatusWarning", w);
+            self.log(Status::Warning, log_category::LOG_STATUS_WARNING, w);
         }
         Ok(if warnings.is_empty() {
             Status::Ok

@@ -14,6 +14,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#if !defined(VR_BASE_A) || !defined(VR_SLOSH_X) || !defined(VR_ETA)
+#error "compile with -DVR_BASE_A=.. -DVR_SLOSH_X=.. -DVR_ETA=.. (scripts/leakcheck reads them from modelDescription.xml)"
+#endif
+
 typedef void *comp_t;
 typedef void (*logger_t)(void *, const char *, int, const char *, const char *, ...);
 typedef struct {
@@ -68,7 +72,8 @@ int main(int argc, char **argv) {
     LOAD(fmi2FreeFMUstate) LOAD(fmi2SerializedFMUstateSize) LOAD(fmi2SerializeFMUstate)
     LOAD(fmi2DeSerializeFMUstate)
     callbacks_t cb = { logger, NULL, NULL, NULL, NULL };
-    const unsigned base_a = 50, slosh_x = 63, eta = 8, unknown = 9999;
+    /* Value references from modelDescription.xml, passed in by scripts/leakcheck. */
+    const unsigned base_a = VR_BASE_A, slosh_x = VR_SLOSH_X, eta = VR_ETA, unknown = 9999;
     double x = 0.0;
     int cycle;
     for (cycle = 0; cycle < cycles; cycle++) {

@@ -11,7 +11,7 @@ use crate::fmi::calls::{self, Call};
 use crate::fmi::instance::Instance;
 use crate::fmi::logger::Logger;
 use crate::fmi::status::{Refusal, Status, refuse};
-use crate::fmi::vars::GUID;
+use crate::fmi::vars::{GUID, log_category};
 
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
@@ -44,7 +44,12 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let name = unsafe { host_text(instanceName) };
         let report = |name: &str, message: &str| {
             let name = CString::new(name.replace('\0', " ")).unwrap_or_default();
-            logger.log(&name, Status::Error, "logStatusError", message);
+            logger.log(
+                &name,
+                Status::Error,
+                log_category::LOG_STATUS_ERROR,
+                message,
+            );
         };
         let Some(name) = name else {
             report("TLD", "fmi2Instantiate: instanceName is NULL");

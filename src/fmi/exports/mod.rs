@@ -16,6 +16,7 @@ use fmi_sys::fmi2::{fmi2Component, fmi2Status, fmi2String};
 use super::calls::Call;
 use super::instance::Instance;
 use super::status::{Refusal, Reply, Status, refuse};
+use super::vars::log_category;
 
 /// The one way into an instance: `body` runs on the instance behind `c` if `call` is allowed in
 /// its phase; refusals become logged statuses, and a panic a logged fmi2Error that leaves the
@@ -51,15 +52,15 @@ fn report(inst: &mut Instance, call: &Call, reply: Reply) -> fmi2Status {
         // Carried out (a warning has said why itself): traced when the host asked for logCalls.
         Ok(status) => {
             if inst.logs_calls() {
-                inst.log(Status::Ok, "logCalls", call.name);
+                inst.log(Status::Ok, log_category::LOG_CALLS, call.name);
             }
             status as fmi2Status
         }
         Err(Refusal { status, message }) => {
             let category = if status >= Status::Error {
-                "logStatusError"
+                log_category::LOG_STATUS_ERROR
             } else {
-                "logStatusWarning"
+                log_category::LOG_STATUS_WARNING
             };
             inst.log(status, category, &message);
             status as fmi2Status
@@ -75,7 +76,7 @@ fn broken(inst: &mut Instance, call: &Call, panic: Box<dyn std::any::Any + Send>
     inst.set_broken();
     inst.log(
         Status::Error,
-        "logStatusError",
+        log_category::LOG_STATUS_ERROR,
         &format!(
             "{}: internal error (please report it); call fmi2Reset or fmi2FreeInstance",
             call.name
