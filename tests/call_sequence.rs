@@ -187,3 +187,28 @@ fn reset_returns_to_a_fresh_instance() {
     inst.initialise();
     assert_eq!(inst.run_harmonic(100, 0.01).to_bits(), first.to_bits());
 }
+
+/// With every call logged, a refused call logs its refusal only (not an OK line for the call
+/// first), and the refusal of a step before initialisation says what to call; a call that is
+/// carried out is traced after it.
+#[test]
+fn logged_calls_are_traced_after_they_succeed() {
+    let mut inst = Instance::new("traced");
+    // SAFETY: our instance; no categories (all of them).
+    let on = unsafe { inst.lib.fmi2SetDebugLogging(inst.c, 1, 0, std::ptr::null()) };
+    assert_eq!(on, OK);
+    let before = inst.logs().len();
+    assert_eq!(inst.do_step(0.01), ERROR);
+    let refused: Vec<String> = inst.logs()[before..].to_vec();
+    assert_eq!(refused.len(), 1, "{refused:?}");
+    for hint in [
+        "fmi2SetupExperiment",
+        "fmi2EnterInitializationMode",
+        "fmi2ExitInitializationMode",
+    ] {
+        assert!(refused[0].contains(hint), "{}", refused[0]);
+    }
+    let before = inst.logs().len();
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.logs()[before..], ["fmi2SetupExperiment".to_string()]);
+}
