@@ -1,8 +1,10 @@
 //! The nonlinear shallow-water equations in the tank frame (MODEL.md section 7):
 //!
-//!     H_t + q_x = 0
-//!     q_t + (q^2/H + g_e H^2/2)_x = -H a_b(t) - c q,     q = 0 at x = 0 and x = a,
-//!     g_e = g sigma, sigma = tanh(pi h/a)/(pi h/a),      c = 2 zeta omega_1,
+//! ```text
+//! H_t + q_x = 0
+//! q_t + (q^2/H + g_e H^2/2)_x = -H a_b(t) - c q,     q = 0 at x = 0 and x = a,
+//! g_e = g sigma, sigma = tanh(pi h/a)/(pi h/a),      c = 2 zeta omega_1,
+//! ```
 //!
 //! solved by a second-order Godunov-type finite-volume scheme ([`scheme`]: limited
 //! reconstruction, HLL fluxes, well balanced and positivity preserving), SSPRK3 in time, the
