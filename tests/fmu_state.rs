@@ -5,7 +5,7 @@
 mod common;
 
 use common::*;
-use tld_fmu::fmi::vars::vr;
+use tld_fmu::fmi::vars::{ModelKindItem, vr};
 
 /// Get a state, run on, set it back, run the same again: bit-identical.
 #[test]
@@ -138,6 +138,48 @@ fn bad_serialized_states_are_refused() {
         inst.lib.fmi2FreeFMUstate(inst.c, &mut s);
     }
     assert_eq!(inst.run_harmonic(50, 0.01).to_bits(), reference.to_bits());
+}
+
+/// The shallow-water model's state (every cell's depth and discharge, the work done) survives
+/// a serialised round trip into another instance, and both continue bit for bit.
+#[test]
+fn shallow_water_state_round_trip() {
+    let start = |name: &str| {
+        let inst = Instance::new(name);
+        assert_eq!(inst.setup(), OK);
+        assert_eq!(inst.enter(), OK);
+        assert_eq!(
+            inst.set_integer(vr::MODEL, ModelKindItem::ShallowWater.value() as i32),
+            OK
+        );
+        assert_eq!(inst.set_integer(vr::SWE_CELLS, 30), OK);
+        assert_eq!(inst.exit(), OK);
+        inst
+    };
+    let mut a = start("swe-source");
+    a.run_harmonic(200, 0.01);
+    let s = get_state(&a);
+    let bytes = serialize(&a, s);
+    let t_saved = a.time;
+    let uninterrupted = a.run_harmonic(200, 0.01);
+    let mut b = start("swe-target");
+    let (status, restored) = deserialize(&b, &bytes);
+    assert_eq!(status, OK, "{:?}", b.logs());
+    assert_eq!(
+        unsafe { b.lib.fmi2SetFMUstate(b.c, restored) },
+        OK,
+        "{:?}",
+        b.logs()
+    );
+    b.time = t_saved;
+    let continued = b.run_harmonic(200, 0.01);
+    assert_eq!(continued.to_bits(), uninterrupted.to_bits());
+    let mut s = s;
+    let mut r = restored;
+    unsafe {
+        a.lib.fmi2FreeFMUstate(a.c, &mut s);
+        b.lib.fmi2FreeFMUstate(b.c, &mut r);
+    }
 }
 
 /// The S^2 model's state (impact mass position, velocity, wall contact, count) survives a

@@ -5,6 +5,7 @@
 mod common;
 
 use common::*;
+use tld_fmu::fmi::vars::{ModelKindItem, vr};
 use tld_fmu::model::{Damper, Inputs, Output, StartValues};
 
 /// The FMI layer adds nothing and loses nothing: the same run through the C interface and
@@ -31,23 +32,33 @@ fn fmi_layer_is_transparent() {
     assert!(x_fmu.abs() > 1e-3, "the run must actually slosh: {x_fmu}");
 }
 
+/// Instances in threads give the serial runs' numbers bit for bit, for every model (the
+/// items of the model description's `model` enumeration), two instances of each.
 #[test]
 fn concurrent_instances_match_serial_runs() {
-    let serial: Vec<u64> = (0..4)
-        .map(|k| {
-            let mut inst = Instance::new(&format!("serial-{k}"));
-            inst.initialise();
-            inst.run_harmonic(300 + 50 * k, 0.01).to_bits()
-        })
+    let models: Vec<i32> = ModelKindItem::ALL
+        .iter()
+        .map(|m| m.value() as i32)
         .collect();
-    let threads: Vec<_> = (0..4usize)
-        .map(|k| {
-            std::thread::spawn(move || {
-                let mut inst = Instance::new(&format!("thread-{k}"));
-                inst.initialise();
-                inst.run_harmonic(300 + 50 * k, 0.01).to_bits()
-            })
-        })
+    let run = move |name: String, model: i32, k: usize| {
+        let mut inst = Instance::new(&name);
+        assert_eq!(inst.setup(), OK);
+        assert_eq!(inst.enter(), OK);
+        assert_eq!(inst.set_integer(vr::MODEL, model), OK);
+        assert_eq!(inst.exit(), OK);
+        inst.run_harmonic(300 + 50 * k, 0.01).to_bits()
+    };
+    let cases: Vec<(i32, usize)> = models
+        .iter()
+        .flat_map(|&m| (0..2usize).map(move |k| (m, k)))
+        .collect();
+    let serial: Vec<u64> = cases
+        .iter()
+        .map(|&(m, k)| run(format!("serial-{m}-{k}"), m, k))
+        .collect();
+    let threads: Vec<_> = cases
+        .iter()
+        .map(|&(m, k)| std::thread::spawn(move || run(format!("thread-{m}-{k}"), m, k)))
         .collect();
     let parallel: Vec<u64> = threads
         .into_iter()

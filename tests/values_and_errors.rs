@@ -200,7 +200,7 @@ fn out_of_range_and_inconsistent_parameters() {
         "not an enumeration item"
     );
     assert_eq!(
-        inst.set_integer(vr::MODEL, 5),
+        inst.set_integer(vr::MODEL, 6),
         ERROR,
         "not an item of ModelKind"
     );

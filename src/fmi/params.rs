@@ -4,6 +4,10 @@
 use super::vars::{Causality, VARIABLES, VR_INDEX, VarType, index_of, vr};
 use crate::model::{Derived, Inputs, Output, Parameters};
 
+/// The variables of the first build with saved-state format version 1 (modelDescription.xml
+/// up to solver_id); variables added since are appended after them.
+pub const VERSION_1_VARIABLES: usize = 54;
+
 /// Values of all variables, in the order of `VARIABLES` (integers and enumerations as f64).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Values([f64; VARIABLES.len()]);
@@ -29,7 +33,9 @@ impl Values {
     /// Values checked one by one against the model description (finite, in range, an
     /// enumeration item); calculated variables carry no value and are ignored.
     pub fn from_saved(saved: &[f64]) -> Result<Self, String> {
-        if saved.len() != VARIABLES.len() {
+        // Variables added after the first version-1 build are listed only up to the last one
+        // away from its start ([`Values::to_saved`]); the others keep their start values.
+        if !(VERSION_1_VARIABLES..=VARIABLES.len()).contains(&saved.len()) {
             return Err(format!(
                 "{} values for {} variables",
                 saved.len(),
@@ -48,8 +54,17 @@ impl Values {
         Ok(values)
     }
 
-    pub fn as_slice(&self) -> &[f64] {
-        &self.0
+    /// The values a saved state lists: the variables of the first version-1 build always, the
+    /// ones added since (appended to the model description, never inserted) up to the last one
+    /// not at its start value. A state of a run that leaves the new variables alone is then
+    /// byte for byte the state the earlier builds wrote, and their states restore here.
+    pub fn to_saved(&self) -> &[f64] {
+        let start = Values::start();
+        let mut n = self.0.len();
+        while n > VERSION_1_VARIABLES && self.0[n - 1].to_bits() == start.0[n - 1].to_bits() {
+            n -= 1;
+        }
+        &self.0[..n]
     }
 
     pub fn get(&self, vr: u32) -> f64 {
@@ -236,6 +251,8 @@ pub const fn output_of(vr: u32) -> Option<Output> {
         vr::ZETA_EFFECTIVE => Output::Zeta,
         vr::IMPACT_Z => Output::ImpactZ,
         vr::IMPACTS => Output::Impacts,
+        vr::SURFACE_LEFT => Output::SurfaceLeft,
+        vr::SURFACE_RIGHT => Output::SurfaceRight,
         _ => return None,
     })
 }

@@ -7,7 +7,8 @@
 //!        | payload length u32 | payload | FNV-1a 64 checksum of everything before it
 //! payload: phase u8 | flags u8 | time, tolerance, start, stop f64
 //!        | derivatives of base.a for the next step (orders 1, 2) f64
-//!        | number of variables u32 | their values f64...
+//!        | number of variables u32 | their values f64... (the 54 of the first version-1
+//!          build, then those added since up to the last one away from its start value)
 //!        | number of simulation values u32 (0: not initialised) | the values f64...
 //! simulation values: the model's own part (`Model::save`: its state, then three numbers the
 //!        integrator carries, 0 for the exact models) | the damper's frame (amplitude, mean-force
@@ -220,7 +221,7 @@ impl Instance {
             stop: self.experiment.stop,
             time: self.time,
             a_derivatives: self.a_derivatives,
-            values: self.values.as_slice().to_vec(),
+            values: self.values.to_saved().to_vec(),
             simulation: self.sim.as_ref().map(Damper::snapshot).unwrap_or_default(),
         }
         .encode()

@@ -3,7 +3,7 @@
 use super::{Parameters, choice};
 use crate::description::{AmplitudeModeItem, DampingLawItem, vr};
 use crate::physics::geometry::Tank;
-use crate::physics::laws::{DampingLaw, LambdaRange};
+use crate::physics::laws::{DampingLaw, LambdaRange, boundary_layer_zeta};
 
 /// Where the excitation amplitude of the amplitude laws comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,12 +41,26 @@ pub struct Derived {
 impl Common {
     /// The shared parameters and the warnings they deserve; Err if they cannot be simulated.
     pub fn read(p: &dyn Parameters) -> Result<(Self, Vec<String>), String> {
+        let tank = Tank {
+            length: p.value(vr::TANK_LENGTH),
+            breadth: p.value(vr::TANK_BREADTH),
+            depth: p.value(vr::TANK_DEPTH),
+            density: p.value(vr::LIQUID_DENSITY),
+            g: p.value(vr::G),
+        };
         let damping = match choice(p, vr::DAMPING)? {
             DampingLawItem::Constant => DampingLaw::Constant(p.value(vr::ZETA)),
             DampingLawItem::NSD => DampingLaw::Nsd {
                 c: p.value(vr::NSD_C),
                 p: p.value(vr::NSD_P),
             },
+            DampingLawItem::BoundaryLayer => DampingLaw::BoundaryLayer(boundary_layer_zeta(
+                tank.fundamental().omega,
+                tank.depth,
+                tank.breadth,
+                p.value(vr::LIQUID_VISCOSITY),
+                p.value(vr::DAMPING_CONTAMINATION),
+            )),
         };
         let amplitude = match choice(p, vr::AMPLITUDE)? {
             AmplitudeModeItem::Fixed => AmplitudeSource::Fixed(p.value(vr::A_E)),
@@ -56,13 +70,7 @@ impl Common {
             },
         };
         let common = Common {
-            tank: Tank {
-                length: p.value(vr::TANK_LENGTH),
-                breadth: p.value(vr::TANK_BREADTH),
-                depth: p.value(vr::TANK_DEPTH),
-                density: p.value(vr::LIQUID_DENSITY),
-                g: p.value(vr::G),
-            },
+            tank,
             tanks: p.count(vr::TANKS),
             damping,
             lambda: LambdaRange {

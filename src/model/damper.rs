@@ -232,7 +232,24 @@ impl Damper {
             Output::Zeta => self.zeta,
             Output::ImpactZ => observe(Observable::ImpactZ),
             Output::Impacts => observe(Observable::Impacts),
+            Output::SurfaceLeft | Output::SurfaceRight => {
+                let k = usize::from(which == Output::SurfaceRight);
+                self.model
+                    .surface()
+                    .map_or(self.mode_surface(k) * self.sloshing.0, |s| s[k])
+            }
         }
+    }
+
+    /// Wave height at wall `k` (0: x = 0, 1: x = a) per metre of slosh.x for the models that do
+    /// not resolve the surface: the fundamental shallow-water mode cos(pi x/a) with the first
+    /// moment m_1 x (integral of rho b eta (x - a/2) dx = -2 rho b a^2 eta(0)/pi^2), so
+    /// eta(0) = -pi^2 m_1 x/(2 rho b a^2) and eta(a) = -eta(0).
+    fn mode_surface(&self, k: usize) -> f64 {
+        let t = &self.common.tank;
+        let left = -std::f64::consts::PI.powi(2) * t.fundamental().mass
+            / (2.0 * t.density * t.breadth * t.length * t.length);
+        if k == 0 { left } else { -left }
     }
 
     /// The exact first time derivative of the output `which` now (0 for quantities constant
@@ -243,6 +260,10 @@ impl Damper {
             Output::BaseShear => {
                 self.model.rate(Output::Force, a, a_rate)
                     - (self.derived.mass_inactive + self.model.rigid_mass()) * a_rate
+            }
+            Output::SurfaceLeft | Output::SurfaceRight if self.model.surface().is_none() => {
+                let k = usize::from(which == Output::SurfaceRight);
+                self.mode_surface(k) * self.model.rate(Output::X, a, a_rate)
             }
             _ => self.model.rate(which, a, a_rate),
         }

@@ -12,6 +12,7 @@ mod registry;
 pub mod auto;
 pub mod linear;
 pub mod nonlinear;
+pub mod shallow_water;
 pub mod slamming;
 
 pub use common::{AmplitudeSource, Common, Derived};
@@ -56,6 +57,9 @@ pub enum Output {
     /// S^2: position of the impact mass relative to the tank centre [m], and impacts so far.
     ImpactZ,
     Impacts,
+    /// Wave height above the still level at the walls x = 0 and x = a [m].
+    SurfaceLeft,
+    SurfaceRight,
 }
 
 /// The quantities of a model's state that the outputs are made of.
@@ -173,6 +177,12 @@ pub trait Model: Sized {
     }
 
     fn observe(&self, which: Observable) -> f64;
+
+    /// Wave heights at the walls x = 0 and x = a [m], for a model that resolves the surface;
+    /// None: the damper shows the fundamental mode's from x (its rates then from x's).
+    fn surface(&self) -> Option<[f64; 2]> {
+        None
+    }
 
     /// Exact first time derivative of `which` now, with base acceleration `a` and its rate
     /// `a_rate`; only the outputs the model's state makes (force, x, v, energies).

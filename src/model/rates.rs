@@ -47,6 +47,8 @@ pub fn rate(which: Output, oscillators: &[Oscillator], free: &[(f64, f64)], a: f
         | Output::Amplitude
         | Output::Zeta
         | Output::ImpactZ
-        | Output::Impacts => 0.0,
+        | Output::Impacts
+        | Output::SurfaceLeft
+        | Output::SurfaceRight => 0.0,
     }
 }

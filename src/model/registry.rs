@@ -58,6 +58,10 @@ macro_rules! registry {
                 match self { $( AnyModel::$variant(m) => m.rigid_mass(), )* }
             }
 
+            pub fn surface(&self) -> Option<[f64; 2]> {
+                match self { $( AnyModel::$variant(m) => m.surface(), )* }
+            }
+
             pub fn observe(&self, which: Observable) -> f64 {
                 match self { $( AnyModel::$variant(m) => m.observe(which), )* }
             }
@@ -90,4 +94,5 @@ registry! {
     Nonlinear => Nonlinear(super::nonlinear::Nonlinear),
     SloshingSlamming => SloshingSlamming(super::slamming::SloshingSlamming),
     Auto => Auto(super::auto::NonlinearAuto),
+    ShallowWater => ShallowWater(super::shallow_water::ShallowWater),
 }

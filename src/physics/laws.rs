@@ -1,5 +1,6 @@
-//! Amplitude-dependent properties (MODEL.md section 2): the NSD fits of Yu, Wakahara & Reed
-//! (1999) as parameters, with Lambda = A_e / a clamped to the fitted range.
+//! Damping laws: the amplitude-dependent NSD fits of Yu, Wakahara & Reed (1999) as parameters,
+//! with Lambda = A_e / a clamped to the fitted range (MODEL.md section 2), and the laminar
+//! boundary layers' amplitude-independent damping (MODEL.md section 8).
 
 /// Clamp range of the non-dimensional excitation amplitude Lambda = A_e / a.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -25,6 +26,17 @@ pub enum DampingLaw {
     Constant(f64),
     /// zeta = c Lambda^p (NSD fit: c = 0.5, p = 0.35).
     Nsd { c: f64, p: f64 },
+    /// The boundary layers' zeta ([`boundary_layer_zeta`]), fixed by the tank and the liquid.
+    BoundaryLayer(f64),
+}
+
+/// Damping ratio of the fundamental mode by the laminar boundary layers on the bottom and the
+/// side walls (Miles 1967, as used by Sun et al. 1992; MODEL.md section 8):
+/// zeta = (1/(2 omega_1 h)) sqrt(nu omega_1/2) (1 + 2h/b + S), for natural frequency
+/// `omega_1`, still depth `depth`, breadth `breadth`, kinematic viscosity `nu` and surface
+/// contamination factor `s` (about 1 for tap water).
+pub fn boundary_layer_zeta(omega_1: f64, depth: f64, breadth: f64, nu: f64, s: f64) -> f64 {
+    (nu * omega_1 / 2.0).sqrt() * (1.0 + 2.0 * depth / breadth + s) / (2.0 * omega_1 * depth)
 }
 
 impl DampingLaw {
@@ -33,6 +45,7 @@ impl DampingLaw {
         match *self {
             DampingLaw::Constant(z) => z,
             DampingLaw::Nsd { c, p } => c * range.clamp(a_e / length).powf(p),
+            DampingLaw::BoundaryLayer(z) => z,
         }
     }
 }
@@ -67,6 +80,16 @@ mod tests {
         assert_eq!(law.zeta(10.0, 0.25, RANGE), 0.5 * 0.1f64.powf(0.35));
         assert_eq!(law.zeta(f64::NAN, 0.25, RANGE), law.zeta(0.0, 0.25, RANGE));
         assert_eq!(DampingLaw::Constant(0.02).zeta(1.0, 0.25, RANGE), 0.02);
+    }
+
+    /// MODEL.md section 8's check value: the lab tank with water (nu = 1e-6 m^2/s, S = 1).
+    #[test]
+    fn boundary_layer_damping_of_the_lab_tank() {
+        let t = crate::physics::geometry::Tank::TABLE_2_1;
+        let z = boundary_layer_zeta(t.fundamental().omega, t.depth, t.breadth, 1e-6, 1.0);
+        assert!((z - 0.0151).abs() < 5e-5, "{z}");
+        let law = DampingLaw::BoundaryLayer(z);
+        assert_eq!(law.zeta(0.0, 0.25, RANGE), law.zeta(1.0, 0.25, RANGE));
     }
 
     #[test]

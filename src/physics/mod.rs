@@ -8,4 +8,5 @@ pub mod laws;
 pub mod linear;
 pub mod nonlinear;
 pub mod power;
+pub mod shallow_water;
 pub mod slamming;

@@ -1,0 +1,164 @@
+//! The shallow-water model through the damper, as a host sees it: its outputs keep the
+//! momentum and energy balances, its output rates are the time derivatives of its outputs,
+//! and the swe.cells convergence study behind the parameter's default.
+
+use crate::description::vr;
+use crate::model::{Damper, Inputs, Output, StartValues};
+
+const SHALLOW_WATER: f64 = 5.0;
+const CONSTANT: f64 = 1.0;
+const BOUNDARY_LAYER: f64 = 3.0;
+const FIXED: f64 = 1.0;
+
+fn shallow(cells: f64) -> StartValues {
+    StartValues::default()
+        .with(vr::MODEL, SHALLOW_WATER)
+        .with(vr::SWE_CELLS, cells)
+        .with(vr::DAMPING, BOUNDARY_LAYER)
+        .with(vr::AMPLITUDE, FIXED)
+}
+
+fn damper(p: &StartValues) -> Damper {
+    Damper::configure(p).expect("configuration").0
+}
+
+/// Base acceleration -w^2 A sin(w t) as the inputs at t, with its first two derivatives.
+fn harmonic(t: f64, w: f64, amplitude: f64) -> Inputs {
+    let (s, c) = (w * t).sin_cos();
+    Inputs {
+        a: -w * w * amplitude * s,
+        v: w * amplitude * c,
+        a_derivatives: [-w.powi(3) * amplitude * c, w.powi(4) * amplitude * s],
+    }
+}
+
+/// Through the outputs alone: mass.inactive = 0, base_shear = force, and per step
+/// h force.mean = -M_l integral a_b dt - Delta(rho b integral q dx), with rho b integral q dx
+/// = m_1 slosh.v per tank (slosh.v's definition), to round-off of the impulse; energy.input =
+/// stored + dissipated and dissipated never decreasing, through bores.
+#[test]
+fn outputs_keep_the_momentum_and_energy_balances() {
+    let p = shallow(40.0).with(vr::TANKS, 2.0);
+    let mut sim = damper(&p);
+    let d = sim.derived();
+    assert_eq!(d.mass_inactive, 0.0);
+    let m1 = 2.0 * crate::physics::geometry::Tank::TABLE_2_1.fundamental().mass;
+    let w = d.omega_f;
+    let h = 0.01;
+    let momentum = |sim: &Damper| m1 * sim.output(Output::V, &Inputs::default());
+    let mut p0 = momentum(&sim);
+    let (mut worst, mut scale): (f64, f64) = (0.0, 0.0);
+    let mut last_dissipated = 0.0;
+    for k in 0..1000 {
+        let inputs = harmonic(k as f64 * h, w, 0.005);
+        sim.step(k as f64 * h, h, &inputs).expect("step");
+        let base = crate::physics::base::BaseAcceleration {
+            t0: 0.0,
+            a: [inputs.a, inputs.a_derivatives[0], inputs.a_derivatives[1]],
+        };
+        let out = |o| sim.output(o, &inputs);
+        let p1 = momentum(&sim);
+        let impulse = h * out(Output::ForceMean);
+        worst = worst.max((impulse + d.mass_liquid * base.integral(h) + (p1 - p0)).abs());
+        scale = scale.max(impulse.abs());
+        p0 = p1;
+        assert_eq!(out(Output::BaseShear), out(Output::Force));
+        let (input, stored, dissipated) = (
+            out(Output::EnergyInput),
+            out(Output::EnergyStored),
+            out(Output::EnergyDissipated),
+        );
+        assert!((input - stored - dissipated).abs() <= 1e-15 * input.abs().max(1e-300) * 4.0);
+        assert!(
+            dissipated >= last_dissipated,
+            "step {k}: {dissipated} < {last_dissipated}"
+        );
+        last_dissipated = dissipated;
+    }
+    eprintln!("model momentum: residual {worst:e} of impulses up to {scale:e}");
+    assert!(worst < 1e-13 * scale, "{worst:e} vs {scale:e}");
+}
+
+/// The output derivatives are the time derivatives of the outputs: over a step of 1e-6 s (one
+/// substep) the outputs' difference quotients match them to the quotient's own error, about
+/// the step times the second derivative (relative 1e-6 of w = 5.6/s: 1e-5 asserted).
+#[test]
+fn output_rates_are_the_outputs_derivatives() {
+    let p = shallow(40.0)
+        .with(vr::DAMPING, CONSTANT)
+        .with(vr::ZETA, 0.05)
+        .with(vr::SLOSH_X0, 0.01)
+        .with(vr::SLOSH_V0, 0.02);
+    let mut sim = damper(&p);
+    let inputs = Inputs {
+        a: 0.3,
+        ..Inputs::default()
+    };
+    // Some motion first, so that every rate is far from 0.
+    for k in 0..20 {
+        sim.step(k as f64 * 0.01, 0.01, &inputs).expect("step");
+    }
+    let dt = 1e-6;
+    for which in [
+        Output::Force,
+        Output::X,
+        Output::V,
+        Output::EnergyInput,
+        Output::EnergyStored,
+        Output::EnergyDissipated,
+        Output::SurfaceLeft,
+        Output::SurfaceRight,
+    ] {
+        let rate = sim.output_derivative(which, &inputs);
+        let before = sim.output(which, &inputs);
+        let mut next = sim.clone();
+        next.step(0.2, dt, &inputs).expect("step");
+        let quotient = (next.output(which, &inputs) - before) / dt;
+        eprintln!("{which:?}: rate {rate:e}, quotient {quotient:e}");
+        assert!(
+            (rate - quotient).abs() < 1e-5 * rate.abs().max(quotient.abs()),
+            "{which:?}: {rate} vs {quotient}"
+        );
+    }
+}
+
+/// The convergence study behind swe.cells' default (docs/SHALLOW_WATER.md): the lab tank at
+/// Lambda = A_e/a = 0.02, excited at 0.9, 1.0 and 1.1 omega_1 (near resonance: bores),
+/// boundary-layer damping; the amplitude of the force over 10 periods after 30 s, for 25 to
+/// 800 cells against 1600. Minutes in debug:
+/// `cargo test --release --lib -- --ignored swe_cells_convergence --nocapture`.
+#[test]
+#[ignore]
+fn swe_cells_convergence_study() {
+    let counts = [25.0, 50.0, 100.0, 200.0, 400.0, 800.0, 1600.0];
+    for ratio in [0.9, 1.0, 1.1] {
+        let mut rows = vec![];
+        for cells in counts {
+            let mut sim = damper(&shallow(cells));
+            let w = ratio * sim.derived().omega_f;
+            let period = 2.0 * std::f64::consts::PI / w;
+            let h = 0.01;
+            let (mut force, mut mean): (f64, f64) = (0.0, 0.0);
+            let steps = ((30.0 + 10.0 * period) / h) as usize;
+            let started = std::time::Instant::now();
+            for k in 0..steps {
+                let t = k as f64 * h;
+                let inputs = harmonic(t, w, 0.02 * 0.25);
+                sim.step(t, h, &inputs).expect("step");
+                if t > 30.0 {
+                    force = force.max(sim.output(Output::Force, &inputs).abs());
+                    mean = mean.max(sim.output(Output::ForceMean, &inputs).abs());
+                }
+            }
+            rows.push((cells, force, mean, started.elapsed().as_secs_f64()));
+        }
+        let (_, f_ref, m_ref, _) = rows[rows.len() - 1];
+        for (cells, f, m, secs) in &rows {
+            eprintln!(
+                "w/w1 {ratio}, cells {cells:5}: force amplitude {f:.5} N ({:+.2} %), force.mean {m:.5} N ({:+.2} %), {secs:.2} s",
+                100.0 * (f / f_ref - 1.0),
+                100.0 * (m / m_ref - 1.0)
+            );
+        }
+    }
+}

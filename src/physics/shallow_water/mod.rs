@@ -1,0 +1,388 @@
+//! The nonlinear shallow-water equations in the tank frame (MODEL.md section 7):
+//!
+//! ```text
+//! H_t + q_x = 0
+//! q_t + (q^2/H + g_e H^2/2)_x = -H a_b(t) - c q,     q = 0 at x = 0 and x = a,
+//! g_e = g sigma, sigma = tanh(pi h/a)/(pi h/a),      c = 2 zeta omega_1,
+//! ```
+//!
+//! solved by a second-order Godunov-type finite-volume scheme ([`scheme`]: limited
+//! reconstruction, HLL fluxes, well balanced and positivity preserving), SSPRK3 in time, the
+//! drag integrated exactly by Strang splitting. Per unit of rho b throughout: the model
+//! multiplies by the density, the breadth and the tanks.
+//!
+//! The time step: each substep is the CFL step; the communication step's remainder is divided
+//! into equal substeps n = ceil(remaining / dt_cfl), recomputed after every substep (the speeds
+//! change), so that the last one lands exactly on the communication point.
+
+#[cfg(test)]
+mod exact;
+pub mod scheme;
+#[cfg(test)]
+mod tests;
+
+use crate::physics::base::BaseAcceleration;
+use crate::solver::SolveError;
+use scheme::{Grid, Rates, rates, velocity};
+
+/// Courant number of a substep against the largest interface wave speed. The MUSCL-HLL
+/// forward-Euler stage keeps depths non-negative up to 1/2 (each cell average is the mean of
+/// its two face values, each updated by a first-order HLL step at twice the Courant number);
+/// SSPRK3 is a convex combination of such stages.
+pub const CFL: f64 = 0.45;
+/// The positivity bound itself: a substep whose stages meet a faster wave than this allows is
+/// taken again, shorter.
+const CFL_BOUND: f64 = 0.5;
+
+/// The still-water depth below which a cell is dry, relative to the still depth: its liquid
+/// is a film that the bottom's friction stops (its discharge goes to the tank as an impulse).
+pub const DRY: f64 = 1e-9;
+
+/// A tank's liquid as the scheme sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Channel {
+    /// Tank length a [m].
+    pub length: f64,
+    /// Still-water depth h [m].
+    pub depth: f64,
+    /// Gravity with the dispersion correction, g_e = g sigma [m/s^2].
+    pub g_e: f64,
+    pub cells: usize,
+}
+
+impl Channel {
+    /// The channel of a tank of length `length`, still depth `depth`, under gravity `g`, in
+    /// `cells` cells; g_e = g tanh(pi h/a)/(pi h/a) makes the linear fundamental frequency
+    /// pi sqrt(g_e h)/a equal Eq 2.2's omega_1.
+    pub fn new(length: f64, depth: f64, g: f64, cells: usize) -> Self {
+        let k = std::f64::consts::PI * depth / length;
+        Channel {
+            length,
+            depth,
+            g_e: g * k.tanh() / k,
+            cells,
+        }
+    }
+
+    pub fn dx(&self) -> f64 {
+        self.length / self.cells as f64
+    }
+
+    pub fn grid(&self) -> Grid {
+        Grid {
+            cells: self.cells,
+            dx: self.dx(),
+            g_e: self.g_e,
+            dry: DRY * self.depth,
+        }
+    }
+
+    /// Centre of cell i, from the left wall [m].
+    pub fn centre(&self, i: usize) -> f64 {
+        (i as f64 + 0.5) * self.dx()
+    }
+
+    /// Still water.
+    pub fn at_rest(&self) -> Flow {
+        Flow {
+            depth: vec![self.depth; self.cells],
+            discharge: vec![0.0; self.cells],
+        }
+    }
+
+    /// The liquid volume per unit breadth [m^2].
+    pub fn volume(&self, f: &Flow) -> f64 {
+        f.depth.iter().sum::<f64>() * self.dx()
+    }
+
+    /// The liquid momentum per unit breadth and density, integral of q [m^3/s].
+    pub fn momentum(&self, f: &Flow) -> f64 {
+        f.discharge.iter().sum::<f64>() * self.dx()
+    }
+
+    /// First moment of the depth about the tank centre, integral of H (x - a/2) [m^3]: the
+    /// volume times the centre of mass's offset.
+    pub fn moment(&self, f: &Flow) -> f64 {
+        let mid = 0.5 * self.length;
+        let dx = self.dx();
+        f.depth
+            .iter()
+            .enumerate()
+            .map(|(i, h)| h * (self.centre(i) - mid))
+            .sum::<f64>()
+            * dx
+    }
+
+    /// Mechanical energy per unit breadth and density, integral of q^2/(2H) + g_e (H-h)^2/2
+    /// [m^4/s^2] (the kinetic part with the desingularised velocity, 0 in a dry cell).
+    pub fn energy(&self, f: &Flow) -> f64 {
+        let dry = DRY * self.depth;
+        f.depth
+            .iter()
+            .zip(&f.discharge)
+            .map(|(&h, &q)| {
+                let eta = h - self.depth;
+                0.5 * q * velocity(q, h, dry) + 0.5 * self.g_e * eta * eta
+            })
+            .sum::<f64>()
+            * self.dx()
+    }
+
+    /// Depth at the walls x = 0 and x = a: extrapolated linearly from the two cells next to
+    /// each (second order where the flow is smooth, exact for the tilted lake at rest), not
+    /// below 0. The state alone: no base acceleration enters, so the force built of it has no
+    /// feedthrough.
+    pub fn wall_depths(&self, f: &Flow) -> [f64; 2] {
+        let h = &f.depth;
+        let n = self.cells;
+        if n < 2 {
+            return [h[0], h[0]];
+        }
+        [
+            (1.5 * h[0] - 0.5 * h[1]).max(0.0),
+            (1.5 * h[n - 1] - 0.5 * h[n - 2]).max(0.0),
+        ]
+    }
+
+    /// Force of the liquid on the tank per unit breadth and density [m^3/s^2], state only:
+    /// g_e (H(a)^2 - H(0)^2)/2 + c integral q dx with the extrapolated wall depths.
+    pub fn force(&self, f: &Flow, c: f64) -> f64 {
+        let [l, r] = self.wall_depths(f);
+        0.5 * self.g_e * (r * r - l * l) + c * self.momentum(f)
+    }
+
+    /// The semi-discrete right-hand side at `f` under base acceleration `a` (no drag).
+    pub fn rates(&self, f: &Flow, a: f64) -> Rates {
+        let mut out = Rates::new(self.cells);
+        let mut slopes = vec![0.0; 2 * self.cells];
+        rates(
+            &self.grid(),
+            &f.depth,
+            &f.discharge,
+            a,
+            &mut slopes,
+            &mut out,
+        );
+        out
+    }
+
+    /// Advance `f` by `h` under base acceleration `base` and drag coefficient `c` [1/s], in at
+    /// most `most` substeps. On error `f` is left part-way: callers step a copy.
+    pub fn advance(
+        &self,
+        f: &mut Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+        most: u64,
+    ) -> Result<Advanced, SolveError> {
+        let mut w = Work::new(self.cells);
+        let grid = self.grid();
+        let dx = grid.dx;
+        let mut done = Advanced::default();
+        let mut t = 0.0;
+        // The largest face speed met so far in this step: the next substep's CFL speed.
+        let mut speed = self.cell_speed(f);
+        while t < h {
+            let remaining = h - t;
+            let dt_cfl = if speed > 0.0 {
+                CFL * dx / speed
+            } else {
+                f64::INFINITY
+            };
+            let substeps = (remaining / dt_cfl).ceil().max(1.0);
+            if done.substeps as f64 + substeps > most as f64 {
+                return Err(SolveError::TooManySteps { limit: most, t });
+            }
+            let last = substeps <= 1.0;
+            let dt = if last {
+                remaining
+            } else {
+                remaining / substeps
+            };
+            match self.substep(f, &mut w, t, dt, base, c) {
+                Ok(sub) => {
+                    done.impulse += sub.impulse;
+                    done.work += sub.work;
+                    done.substeps += 1;
+                    speed = sub.speed;
+                    t = if last { h } else { t + dt };
+                }
+                // A wave faster than the step allows: take it again at the CFL step of that
+                // speed (the state is untouched until a substep is accepted).
+                Err(faster) => {
+                    done.rejected += 1;
+                    speed = faster;
+                }
+            }
+            if f.depth.iter().chain(&f.discharge).any(|v| !v.is_finite()) {
+                return Err(SolveError::NonFinite { t });
+            }
+        }
+        Ok(done)
+    }
+
+    /// Largest |u| + sqrt(g_e H) of the cell averages.
+    fn cell_speed(&self, f: &Flow) -> f64 {
+        let dry = DRY * self.depth;
+        f.depth
+            .iter()
+            .zip(&f.discharge)
+            .map(|(&h, &q)| velocity(q, h, dry).abs() + (self.g_e * h.max(0.0)).sqrt())
+            .fold(0.0, f64::max)
+    }
+
+    /// One substep dt from time t: drag dt/2 exactly, SSPRK3 (Shu & Osher 1988) on the
+    /// hyperbolic part and the inertial force, drag dt/2 (Strang: second order, and the drag
+    /// never limits the step). Err(speed): a stage met a wave too fast for dt; nothing changed.
+    fn substep(
+        &self,
+        f: &mut Flow,
+        w: &mut Work,
+        t: f64,
+        dt: f64,
+        base: &BaseAcceleration,
+        c: f64,
+    ) -> Result<Substep, f64> {
+        let grid = self.grid();
+        let dx = grid.dx;
+        let n = self.cells;
+        let limit = CFL_BOUND * dx / dt;
+        let decay = (-0.5 * c * dt).exp();
+        // The drag's impulse on the tank is the momentum it takes from the liquid.
+        let p0 = self.momentum(f);
+        let drag_loss = |p: f64| (1.0 - decay) * p;
+        // U0 = the state after the first drag half.
+        w.h0.copy_from_slice(&f.depth);
+        w.q0.iter_mut()
+            .zip(&f.discharge)
+            .for_each(|(a, q)| *a = q * decay);
+        let mut impulse = drag_loss(p0);
+        // SSPRK3 in Shu-Osher form: stages at t, t + dt, t + dt/2 with the weights 1/6, 1/6,
+        // 2/3 of the final combination (Simpson's rule: the work and the inertial impulse of
+        // a quadratic a_b are integrated exactly).
+        let stages = [(0.0, 1.0 / 6.0), (1.0, 1.0 / 6.0), (0.5, 2.0 / 3.0)];
+        let mut fastest: f64 = 0.0;
+        let mut wall = 0.0;
+        let mut work = 0.0;
+        for (k, &(at, weight)) in stages.iter().enumerate() {
+            let a = base.at(t + at * dt);
+            let (h, q) = match k {
+                0 => (&w.h0, &w.q0),
+                1 => (&w.h1, &w.q1),
+                _ => (&w.h2, &w.q2),
+            };
+            rates(&grid, h, q, a, &mut w.slopes, &mut w.rates);
+            fastest = fastest.max(w.rates.speed);
+            if w.rates.speed > limit {
+                return Err(w.rates.speed);
+            }
+            let r = &w.rates;
+            wall += weight * dt * (r.wall[1] - r.wall[0]);
+            // The inertial force's power on the discrete liquid: -a_b times the rate of its
+            // first moment, dx times the interior mass fluxes. (The continuum's -a_b integral
+            // q dx is the same; this discrete form is the one the scheme's energy is
+            // consistent with, the pseudo-bottom a_b x/g_e entering the hydrostatic
+            // reconstruction as a bottom does.)
+            work -= weight * dt * a * r.mass_flux.iter().sum::<f64>() * dx;
+            // Next stage: (1 - beta) U0 + beta (U_k + dt L(U_k)).
+            let beta = [1.0, 0.25, 2.0 / 3.0][k];
+            let alpha = 1.0 - beta;
+            for i in 0..n {
+                let (hk, qk) = match k {
+                    0 => (w.h0[i], w.q0[i]),
+                    1 => (w.h1[i], w.q1[i]),
+                    _ => (w.h2[i], w.q2[i]),
+                };
+                let hn = alpha * w.h0[i] + beta * (hk + dt * r.depth[i]);
+                let qn = alpha * w.q0[i] + beta * (qk + dt * r.discharge[i]);
+                match k {
+                    0 => (w.h1[i], w.q1[i]) = (hn, qn),
+                    1 => (w.h2[i], w.q2[i]) = (hn, qn),
+                    _ => (f.depth[i], f.discharge[i]) = (hn, qn),
+                }
+            }
+        }
+        impulse += wall;
+        // The second drag half, then the films: a dry cell's discharge goes to the bottom.
+        let p1 = self.momentum(f);
+        impulse += drag_loss(p1);
+        let dry = grid.dry;
+        let mut stopped = 0.0;
+        for (h, q) in f.depth.iter_mut().zip(f.discharge.iter_mut()) {
+            *q *= decay;
+            // Round-off can leave a drained cell a few ulps below 0; the scheme's positivity
+            // guarantees the rest.
+            if *h < dry {
+                *h = h.max(0.0);
+                stopped += *q;
+                *q = 0.0;
+            }
+        }
+        impulse += stopped * dx;
+        Ok(Substep {
+            impulse,
+            work,
+            speed: fastest,
+        })
+    }
+}
+
+/// What a communication step did, per unit breadth and density.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Advanced {
+    /// Impulse of the liquid on the tank [m^3/s]: the wall pressures, the drag and the dry
+    /// cells' friction, summed over the substeps.
+    pub impulse: f64,
+    /// Work of the inertial force -a_b on the liquid, integral of -a_b integral q dx dt
+    /// [m^4/s^2].
+    pub work: f64,
+    pub substeps: u64,
+    /// Substeps taken again, shorter, for a wave faster than the CFL step allowed.
+    pub rejected: u64,
+}
+
+/// One accepted substep.
+struct Substep {
+    impulse: f64,
+    work: f64,
+    /// Largest interface wave speed of its stages.
+    speed: f64,
+}
+
+/// Depths and discharges: the state of the liquid in one tank.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Flow {
+    /// H_i [m].
+    pub depth: Vec<f64>,
+    /// q_i [m^2/s].
+    pub discharge: Vec<f64>,
+}
+
+/// Stage storage of a substep.
+struct Work {
+    h0: Vec<f64>,
+    q0: Vec<f64>,
+    h1: Vec<f64>,
+    q1: Vec<f64>,
+    h2: Vec<f64>,
+    q2: Vec<f64>,
+    slopes: Vec<f64>,
+    rates: Rates,
+}
+
+impl Work {
+    fn new(n: usize) -> Self {
+        let v = || vec![0.0; n];
+        Work {
+            h0: v(),
+            q0: v(),
+            h1: v(),
+            q1: v(),
+            h2: v(),
+            q2: v(),
+            slopes: vec![0.0; 2 * n],
+            rates: Rates::new(n),
+        }
+    }
+}
