@@ -179,14 +179,28 @@ def write_histories(out, kind, s, bare, plt):
     peak = lambda y: float(np.max(np.abs(y)))  # noqa: E731
     bare_drift = np.diff(np.column_stack([np.zeros(len(bare["t"])), bare["X"]]), axis=1)
     less = lambda a, b: f"rms {1e3 * rms(b):.2f} -> {1e3 * rms(a):.2f} mm, {100 * (1 - rms(a) / rms(b)):.0f} % less"  # noqa: E731
-    fig, ax = plt.subplots(5, 1, figsize=(9, 12), sharex=True)
+    fig, ax = plt.subplots(5, 1, figsize=(9, 12), gridspec_kw={"height_ratios": [1.2, 1, 1, 1, 1]})
+    for a_ in ax[2:]:
+        a_.sharex(ax[1])
+    # storey drifts: rms and peak per storey, without and with the dampers (a time history of
+    # several storeys on top of each other hides the reduction)
+    storeys = np.arange(1, drift.shape[1] + 1)
+    for off, d, col, name in ((-0.2, bare_drift, "0.5", "without dampers"), (0.2, drift, "C0", "with TLD.fmu")):
+        ax[0].bar(storeys + off, [1e3 * rms(d[:, i]) for i in range(d.shape[1])], 0.4, color=col,
+                  label=f"{name}: rms")
+        ax[0].plot(storeys + off, [1e3 * peak(d[:, i]) for i in range(d.shape[1])], "v", color=col, mec="k",
+                   label=f"{name}: peak")
     for i in range(drift.shape[1]):
-        ax[0].plot(s["t"], drift[:, i] * 1e3, color=f"C{i}", lw=0.6,
-                   label=f"storey {i + 1} with TLD.fmu ({less(drift[:, i], bare_drift[:, i])})")
-    top = drift.shape[1] - 1
-    ax[0].plot(bare["t"], bare_drift[:, top] * 1e3, "k", lw=0.4, alpha=0.5, zorder=0,
-               label=f"storey {top + 1} without dampers")
+        r0, r1 = rms(bare_drift[:, i]), rms(drift[:, i])
+        p0, p1 = peak(bare_drift[:, i]), peak(drift[:, i])
+        ax[0].annotate(f"rms {100 * (1 - r1 / r0):.0f} % less\npeak {100 * (1 - p1 / p0):.0f} % less",
+                       (storeys[i], 1e3 * max(p0, p1)), textcoords="offset points", xytext=(0, 8), ha="center",
+                       fontsize=8)
+    ax[0].set_xticks(storeys, [f"storey {i}" for i in storeys])
+    ax[0].set_xlim(0.4, drift.shape[1] + 1.6)
+    ax[0].set_ylim(0, 1.45e3 * max(peak(bare_drift), peak(drift)))
     ax[0].set_ylabel("storey drift [mm]"); ax[0].legend(loc="upper right", fontsize=7)
+    ax[0].set_title("storey drifts over the whole run", fontsize=9)
     ax[1].plot(bare["t"], bare["X"][:, -1] * 1e3, "k", lw=0.6, label="without dampers")
     ax[1].plot(s["t"], s["X"][:, -1] * 1e3, "C0", lw=0.6,
                label=f"with TLD.fmu ({less(s['X'][:, -1], bare['X'][:, -1])})")
@@ -198,6 +212,8 @@ def write_histories(out, kind, s, bare, plt):
     ax[2].set_ylabel("roof acc. [m/s2]"); ax[2].legend(loc="upper right", fontsize=7)
     ax[3].plot(s["t"], s["F"], lw=0.6); ax[3].set_ylabel("damper force [N]")
     ax[4].plot(s["t"], s["E"]); ax[4].set_ylabel("dissipated [J]"); ax[4].set_xlabel("t [s]")
+    for a_ in ax[1:4]:
+        a_.tick_params(labelbottom=False)
     fig.suptitle(f"{len(s['X'][0])}-storey building under {'wind-like random floor forces' if kind == 'wind' else 'a ground-motion record'}: "
                  f"with and without TLD.fmu", fontsize=10)
     fig.tight_layout(); fig.savefig(out / f"{kind}.png", dpi=120)
