@@ -14,7 +14,7 @@ grid and the refinement runs as points.
 
 Writes out/fig25/fig25.md and fig25.png; --docs regenerates the tracked docs/fig25.md and
 docs/fig25.png instead. The full run (4 sweeps of 31 frequencies x 150 s, then 35 refinement
-runs) takes 4.5 minutes on 2 cores; --quick (13 frequencies x 60 s, a coarser tolerance) QUICKMIN,
+runs) takes 4.5 minutes on 2 cores; --quick (13 frequencies x 60 s, a coarser tolerance) about 1.5 minutes,
 for a look, not for the docs.
 
 Usage: .venv/bin/python scripts/fig25.py [--quick] [--docs] [--out DIR]   (after scripts/package;

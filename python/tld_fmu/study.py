@@ -247,7 +247,9 @@ def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xto
         bar.update(len(batch))
         return [g["amplification"] for g in got]
 
-    found = pk.refine_curves(curves, evaluate, xtol, every=False)
+    # every grid maximum within half of the largest: a tuned damper's two peaks, either of which
+    # may turn out the higher once refined
+    found = pk.refine_curves(curves, evaluate, xtol, every=True, rel=0.5)
     bar.close()
     out = []
     for c, idx in cases.items():
@@ -258,10 +260,10 @@ def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xto
                         "grid_frequency_ratio": math.nan, "grid_amplification": math.nan, "bounded": False,
                         "refinement_runs": 0, "note": "a grid run failed: not refined"})
             continue
-        p = found[c][0]
+        p = pk.highest(found[c])
         out.append({**base, "peak_frequency_ratio": p.x, "peak_amplification": p.y, "xtol": xtol,
                     "grid_frequency_ratio": p.grid_x, "grid_amplification": p.grid_y, "bounded": p.bounded,
-                    "refinement_runs": len(p.points),
+                    "refinement_runs": sum(len(q.points) for q in found[c]),
                     "note": "" if p.bounded else "peak at the edge of the frequency range: widen it"})
     return out, extra
 
