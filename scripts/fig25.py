@@ -14,7 +14,7 @@ grid and the refinement runs as points.
 
 Writes out/fig25/fig25.md and fig25.png; --docs regenerates the tracked docs/fig25.md and
 docs/fig25.png instead. The full run (4 sweeps of 31 frequencies x 150 s, then 35 refinement
-runs) takes 4.5 minutes on 2 cores; --quick (13 frequencies x 60 s, a coarser tolerance) about 1.5 minutes,
+runs) takes 4.5 minutes on 2 cores; --quick (13 frequencies x 60 s, a coarser tolerance) 35 s,
 for a look, not for the docs.
 
 Usage: .venv/bin/python scripts/fig25.py [--quick] [--docs] [--out DIR]   (after scripts/package;
@@ -94,7 +94,7 @@ def main():
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog=__doc__.split("\n\n", 1)[1])
     ap.add_argument("--quick", action="store_true",
-                    help="13 frequencies x 60 s per run and peaks to +-0.004 (about 3 minutes): a look, not the docs")
+                    help="13 frequencies x 60 s per run and peaks to +-0.004 (35 s): a look, not the docs")
     ap.add_argument("--docs", action="store_true", help="regenerate the tracked docs/fig25.md and docs/fig25.png")
     ap.add_argument("--out", default=str(REPO / "out" / "fig25"), help="where to write without --docs (default out/fig25)")
     ap.add_argument("--jobs", type=int, default=None, help="worker processes (default: one per core)")

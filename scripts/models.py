@@ -6,7 +6,7 @@ high-accuracy solution (tld_fmu.reference) with the same held inputs, so it meas
 how far each model is from Eq 2.11 with the NSD-free scene physics. Cost: median ns per doStep.
 Writes docs/MODELS.md. Needs target/fmu/TLD.fmu (scripts/package) and the native benchmark host
 target/release/tld-bench, which it builds first with cargo if it is missing (saying so: a few
-minutes the first time). About 2 minutes on 2 cores.
+minutes the first time). About 35 s on 2 cores.
     .venv/bin/python scripts/models.py [--dt 0.01]"""
 import argparse
 import shutil
