@@ -9,10 +9,13 @@ the load case and writes the results.
 
     .venv/bin/python scripts/building.py scripts/examples/building.toml [--out out/building]
 
-Writes a CSV and PNG plots (sweep: peak roof displacement with and without the dampers;
+Writes a CSV and PNG plots (sweep: peak roof displacement with and without the dampers, every
+peak refined by tld_fmu.peaks to --xtol, the grid and the refinement runs shown as points;
 record and wind: storey drifts, roof displacement and acceleration with and without the dampers,
 damper forces and energies)."""
 import argparse
+import multiprocessing as mp
+import os
 import sys
 import tempfile
 import tomllib
@@ -20,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tld_fmu import peaks as pk
 from tld_fmu.building import Building, harmonic_ground, simulate, wind_forces
 from tld_fmu.paths import FMU, REPO
 
@@ -29,6 +33,9 @@ def main(argv=None):
     ap.add_argument("config")
     ap.add_argument("--out", default=str(REPO / "out" / "building"))
     ap.add_argument("--fmu", default=str(FMU))
+    ap.add_argument("--xtol", type=float, default=2e-3,
+                    help="harmonic sweep: tolerance of the refined peak frequencies, in w/w_1 (default 0.002)")
+    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: one per core)")
     args = ap.parse_args(argv)
     cfg = tomllib.loads(Path(args.config).read_text())
     from fmpy import extract, read_model_description
@@ -43,30 +50,7 @@ def main(argv=None):
     load, h = cfg["load"], cfg["coupling"]["step"]
     derivs = bool(cfg["coupling"].get("derivatives", False))
     if load["kind"] == "harmonic":
-        b = cfg["building"]
-        w1 = Building(b["masses"], b["stiffnesses"], b["rayleigh"]).omega1
-        Ag = load["ground_amplitude"]
-        ratios = np.linspace(load["from"], load["to"], load["points"])
-        rows = []
-        for r in tqdm(ratios, desc="sweep"):
-            w = r * w1
-            ground = harmonic_ground(w, Ag)
-            peak = []
-            for damped in (False, True):
-                s = simulate(cfg, unzipdir, md, ground, h, load["duration"], with_dampers=damped,
-                             derivatives=derivs)
-                tail = s["t"] > load["duration"] - 20.0
-                peak.append(np.max(np.abs(s["X"][tail, -1])))
-            rows.append((r, *peak))
-        rows = np.array(rows)
-        np.savetxt(out / "sweep.csv", rows, delimiter=",", header="w_over_w1,roof_peak_bare,roof_peak_damped", comments="")
-        plt.figure(figsize=(7, 4))
-        plt.plot(rows[:, 0], rows[:, 1] * 1e3, "k-o", ms=3, label="without dampers")
-        plt.plot(rows[:, 0], rows[:, 2] * 1e3, "C0-o", ms=3, label="with TLD.fmu")
-        plt.xlabel("w / w_1"); plt.ylabel("peak roof displacement [mm]"); plt.grid(alpha=0.3); plt.legend()
-        plt.tight_layout(); plt.savefig(out / "sweep.png", dpi=120)
-        print(f"peak roof displacement: {rows[:, 1].max() * 1e3:.3f} mm without, {rows[:, 2].max() * 1e3:.3f} mm "
-              f"with dampers ({100 * (1 - rows[:, 2].max() / rows[:, 1].max()):.1f} % less); wrote {out}/sweep.csv, sweep.png")
+        sweep(cfg, unzipdir, md, out, args, plt)
     elif load["kind"] in ("record", "wind"):
         if load["kind"] == "record":
             rec = np.loadtxt(Path(args.config).parent / load["record"], delimiter=",")
@@ -92,6 +76,97 @@ def main(argv=None):
         sys.exit(f"unknown load kind {load['kind']!r}: harmonic, record or wind")
 
 
+_RUN = {}   # what the sweep's worker processes need (set before the pool forks)
+
+
+def _roof_peak(job):
+    """Steady peak roof displacement of one sweep run: (with_dampers, w / w_1) -> metres."""
+    damped, r = job
+    cfg, unzipdir, md, w1, load, h, derivs = (_RUN[k] for k in ("cfg", "unzipdir", "md", "w1", "load", "h", "derivs"))
+    s = simulate(cfg, unzipdir, md, harmonic_ground(r * w1, load["ground_amplitude"]), h, load["duration"],
+                 with_dampers=damped, derivatives=derivs)
+    tail = s["t"] > load["duration"] - 20.0
+    return float(np.max(np.abs(s["X"][tail, -1])))
+
+
+def sweep(cfg, unzipdir, md, out, args, plt):
+    """Harmonic ground motion over a grid of frequencies, with and without the dampers; every
+    local maximum of both curves refined (golden section, tld_fmu.peaks) to args.xtol in w/w_1.
+    The bare building's steady state is also given in closed form (it is linear): its transient
+    decays as exp(-zeta w t), slowly at 1 % damping, so the co-simulated bare peaks over the last
+    20 s of a run can fall short of it."""
+    from tqdm import tqdm
+    load, h = cfg["load"], cfg["coupling"]["step"]
+    b = cfg["building"]
+    bare_bld = Building(b["masses"], b["stiffnesses"], b["rayleigh"])
+    w1, Ag = bare_bld.omega1, load["ground_amplitude"]
+    _RUN.update(cfg=cfg, unzipdir=unzipdir, md=md, w1=w1, load=load, h=h,
+                derivs=bool(cfg["coupling"].get("derivatives", False)))
+    ratios = np.linspace(load["from"], load["to"], load["points"])
+    jobs = [(damped, float(r)) for r in ratios for damped in (False, True)]
+    with mp.get_context("fork").Pool(max(1, min(args.jobs, len(jobs)))) as pool:
+        got = list(tqdm(pool.imap(_roof_peak, jobs), total=len(jobs), desc="sweep grid"))
+        grid = {False: np.array(got[0::2]), True: np.array(got[1::2])}
+        bar = tqdm(desc="peak refinement runs")
+
+        def evaluate(batch):
+            bar.update(len(batch))
+            return pool.map(_roof_peak, batch)
+
+        found = pk.refine_curves({d: (ratios, grid[d]) for d in (False, True)}, evaluate, args.xtol)
+        bar.close()
+    # the bare building in closed form: its peak refined to 1e-6
+    closed = lambda r: bare_bld.steady_amplitudes(r * w1, Ag)[-1]  # noqa: E731
+    bare_exact = pk.refine_peak(closed, ratios, xtol=1e-6)
+    top_bare, top_damped = pk.highest(found[False]), pk.highest(found[True])
+    pts = sorted([(r, d, y) for d in (False, True) for r, y in zip(ratios, grid[d])]
+                 + [(x, d, y) for d in (False, True) for p in found[d] for x, y in p.points])
+    np.savetxt(out / "sweep.csv", [(r, int(d), y) for r, d, y in pts], delimiter=",",
+               header="w_over_w1,with_dampers,roof_peak", comments="", fmt=["%.6f", "%d", "%.9g"])
+    with open(out / "sweep-peaks.csv", "w") as fh:
+        fh.write("curve,w_over_w1,roof_peak,xtol,grid_w_over_w1,grid_roof_peak,bounded,refinement_runs\n")
+        for d, name in ((False, "without dampers (co-simulated)"), (True, "with TLD.fmu")):
+            for p in found[d]:
+                fh.write(f"{name},{p.x:.6f},{p.y:.9g},{p.xtol:g},{p.grid_x:.6f},{p.grid_y:.9g},{p.bounded},{len(p.points)}\n")
+        fh.write(f"without dampers (closed form),{bare_exact.x:.6f},{bare_exact.y:.9g},1e-06,"
+                 f"{bare_exact.grid_x:.6f},{bare_exact.grid_y:.9g},{bare_exact.bounded},{len(bare_exact.points)}\n")
+
+    fig, ax = plt.subplots(figsize=(8, 5))
+    fine = np.linspace(load["from"], load["to"], 801)
+    ax.plot(fine, [1e3 * closed(r) for r in fine], "-", color="0.6", lw=1,
+            label="without dampers, closed-form steady state")
+    for d, col, name in ((False, "k", "without dampers"), (True, "C0", "with TLD.fmu")):
+        ax.plot(ratios, 1e3 * grid[d], "o", color=col, ms=4, label=f"{name}: co-simulation, grid")
+        rp = np.array([q for p in found[d] for q in p.points]).reshape(-1, 2)
+        ax.plot(rp[:, 0], 1e3 * rp[:, 1], ".", color=col, ms=5, alpha=0.6,
+                label=f"{name}: refinement runs" if len(rp) else None)
+        for p in found[d]:
+            ax.plot(p.x, 1e3 * p.y, "*", color=col, ms=12, mec="k", mew=0.5)
+            ax.annotate(f"{1e3 * p.y:.2f} mm at {p.x:.3f}", (p.x, 1e3 * p.y), textcoords="offset points",
+                        xytext=(6, 4), fontsize=8, color=col)
+    ax.plot([], [], "*", color="0.5", mec="k", ms=10, label=f"refined peak (+-{args.xtol:g} w_1)")
+    reduction = 1 - top_damped.y / bare_exact.y
+    n_tanks = sum(d.get("tanks", 1) for d in cfg.get("dampers", []))
+    ax.set_title(f"{len(b['masses'])}-storey building (w_1 = {w1:.3f} rad/s, {100 * b['rayleigh'][0]:g} % damping), "
+                 f"{n_tanks} tank(s), ground amplitude {1e3 * Ag:g} mm\n"
+                 f"peak roof displacement {1e3 * bare_exact.y:.2f} -> {1e3 * top_damped.y:.2f} mm "
+                 f"({100 * reduction:.1f} % less)", fontsize=10)
+    ax.set_xlabel("w / w_1 (first mode of the bare building)")
+    ax.set_ylabel("peak roof displacement relative to the ground [mm]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "sweep.png", dpi=120)
+    print(f"peak roof displacement without dampers: {1e3 * bare_exact.y:.3f} mm at w/w_1 = {bare_exact.x:.4f} "
+          f"(closed-form steady state; co-simulated: {pk.describe(top_bare, ' mm', 1e3, 'w/w_1')})")
+    print(f"with dampers: {pk.describe(top_damped, ' mm', 1e3, 'w/w_1')}")
+    for p in found[True]:
+        if p is not top_damped:
+            print(f"  other peak with dampers: {pk.describe(p, ' mm', 1e3, 'w/w_1')}")
+    print(f"peak reduction: {100 * reduction:.1f} % (against the co-simulated bare peak: "
+          f"{100 * (1 - top_damped.y / top_bare.y):.1f} %); wrote {out}/sweep.csv, sweep-peaks.csv, sweep.png")
+
+
 def write_histories(out, kind, s, bare, plt):
     """CSV and PNG of a time-history run (with dampers: s; without: bare), and the reductions."""
     drift = np.diff(np.column_stack([np.zeros(len(s["t"])), s["X"]]), axis=1)
@@ -100,18 +175,48 @@ def write_histories(out, kind, s, bare, plt):
              + ["roof_disp", "roof_disp_bare", "roof_acc", "roof_acc_bare"]
              + [f"force{j}" for j in range(s["F"].shape[1])] + [f"dissipated{j}" for j in range(s["E"].shape[1])])
     np.savetxt(out / f"{kind}.csv", np.column_stack(cols), delimiter=",", header=",".join(names), comments="")
-    fig, ax = plt.subplots(5, 1, figsize=(8, 11), sharex=True)
-    ax[0].plot(s["t"], drift * 1e3); ax[0].set_ylabel("storey drift [mm]")
-    ax[1].plot(bare["t"], bare["X"][:, -1] * 1e3, "k", lw=0.6, label="without dampers")
-    ax[1].plot(s["t"], s["X"][:, -1] * 1e3, "C0", lw=0.6, label="with TLD.fmu")
-    ax[1].set_ylabel("roof displ. [mm]"); ax[1].legend(loc="upper right")
-    ax[2].plot(bare["t"], bare["A"][:, -1], "k", lw=0.6); ax[2].plot(s["t"], s["A"][:, -1], "C0", lw=0.6)
-    ax[2].set_ylabel("roof acc. [m/s2]")
-    ax[3].plot(s["t"], s["F"]); ax[3].set_ylabel("damper force [N]")
-    ax[4].plot(s["t"], s["E"]); ax[4].set_ylabel("dissipated [J]"); ax[4].set_xlabel("t [s]")
-    fig.tight_layout(); fig.savefig(out / f"{kind}.png", dpi=120)
     rms = lambda y: float(np.sqrt(np.mean(y ** 2)))  # noqa: E731
     peak = lambda y: float(np.max(np.abs(y)))  # noqa: E731
+    bare_drift = np.diff(np.column_stack([np.zeros(len(bare["t"])), bare["X"]]), axis=1)
+    less = lambda a, b: f"rms {1e3 * rms(b):.2f} -> {1e3 * rms(a):.2f} mm, {100 * (1 - rms(a) / rms(b)):.0f} % less"  # noqa: E731
+    fig, ax = plt.subplots(5, 1, figsize=(9, 12), gridspec_kw={"height_ratios": [1.2, 1, 1, 1, 1]})
+    for a_ in ax[2:]:
+        a_.sharex(ax[1])
+    # storey drifts: rms and peak per storey, without and with the dampers (a time history of
+    # several storeys on top of each other hides the reduction)
+    storeys = np.arange(1, drift.shape[1] + 1)
+    for off, d, col, name in ((-0.2, bare_drift, "0.5", "without dampers"), (0.2, drift, "C0", "with TLD.fmu")):
+        ax[0].bar(storeys + off, [1e3 * rms(d[:, i]) for i in range(d.shape[1])], 0.4, color=col,
+                  label=f"{name}: rms")
+        ax[0].plot(storeys + off, [1e3 * peak(d[:, i]) for i in range(d.shape[1])], "v", color=col, mec="k",
+                   label=f"{name}: peak")
+    for i in range(drift.shape[1]):
+        r0, r1 = rms(bare_drift[:, i]), rms(drift[:, i])
+        p0, p1 = peak(bare_drift[:, i]), peak(drift[:, i])
+        ax[0].annotate(f"rms {100 * (1 - r1 / r0):.0f} % less\npeak {100 * (1 - p1 / p0):.0f} % less",
+                       (storeys[i], 1e3 * max(p0, p1)), textcoords="offset points", xytext=(0, 8), ha="center",
+                       fontsize=8)
+    ax[0].set_xticks(storeys, [f"storey {i}" for i in storeys])
+    ax[0].set_xlim(0.4, drift.shape[1] + 1.6)
+    ax[0].set_ylim(0, 1.45e3 * max(peak(bare_drift), peak(drift)))
+    ax[0].set_ylabel("storey drift [mm]"); ax[0].legend(loc="upper right", fontsize=7)
+    ax[0].set_title("storey drifts over the whole run", fontsize=9)
+    ax[1].plot(bare["t"], bare["X"][:, -1] * 1e3, "k", lw=0.6, label="without dampers")
+    ax[1].plot(s["t"], s["X"][:, -1] * 1e3, "C0", lw=0.6,
+               label=f"with TLD.fmu ({less(s['X'][:, -1], bare['X'][:, -1])})")
+    ax[1].set_ylabel("roof displ. [mm]"); ax[1].legend(loc="upper right", fontsize=7)
+    ax[2].plot(bare["t"], bare["A"][:, -1], "k", lw=0.6, label="without dampers")
+    ax[2].plot(s["t"], s["A"][:, -1], "C0", lw=0.6,
+               label=f"with TLD.fmu (rms {rms(bare['A'][:, -1]):.3f} -> {rms(s['A'][:, -1]):.3f} m/s2, "
+                     f"{100 * (1 - rms(s['A'][:, -1]) / rms(bare['A'][:, -1])):.0f} % less)")
+    ax[2].set_ylabel("roof acc. [m/s2]"); ax[2].legend(loc="upper right", fontsize=7)
+    ax[3].plot(s["t"], s["F"], lw=0.6); ax[3].set_ylabel("damper force [N]")
+    ax[4].plot(s["t"], s["E"]); ax[4].set_ylabel("dissipated [J]"); ax[4].set_xlabel("t [s]")
+    for a_ in ax[1:4]:
+        a_.tick_params(labelbottom=False)
+    fig.suptitle(f"{len(s['X'][0])}-storey building under {'wind-like random floor forces' if kind == 'wind' else 'a ground-motion record'}: "
+                 f"with and without TLD.fmu", fontsize=10)
+    fig.tight_layout(); fig.savefig(out / f"{kind}.png", dpi=120)
     for label, f in (("rms", rms), ("peak", peak)):
         d, d0 = f(s["X"][:, -1]), f(bare["X"][:, -1])
         a, a0 = f(s["A"][:, -1]), f(bare["A"][:, -1])

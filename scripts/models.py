@@ -4,7 +4,9 @@ open-loop scenes (tld_fmu.scenes), measured through the native host (bench/nativ
 Error: max |x - x_ref| / max |x_ref| over the whole history, x_ref the Nonlinear model's
 high-accuracy solution (tld_fmu.reference) with the same held inputs, so it measures
 how far each model is from Eq 2.11 with the NSD-free scene physics. Cost: median ns per doStep.
-Writes docs/MODELS.md. Usage: scripts/bench builds what it needs; then
+Writes docs/MODELS.md. Needs target/fmu/TLD.fmu (scripts/package) and the native benchmark host
+target/release/tld-bench, which it builds first with cargo if it is missing (saying so: a few
+minutes the first time). About 35 s on 2 cores.
     .venv/bin/python scripts/models.py [--dt 0.01]"""
 import argparse
 import shutil
@@ -37,6 +39,15 @@ def main():
     ap.add_argument("--dt", type=float, default=0.01)
     args = ap.parse_args()
     dt = args.dt
+    # check what the runs need before the references (about a minute) are computed
+    if not FMU.is_file():
+        raise SystemExit(f"models.py: {FMU} not found: run scripts/package first")
+    if not bench.NATIVE_BIN.is_file():
+        print(f"models.py: building the native benchmark host {bench.NATIVE_BIN.relative_to(REPO)} "
+              "(cargo build --release -p tld-bench; a few minutes the first time)", flush=True)
+    build = subprocess.run(["cargo", "build", "--release", "--quiet", "-p", "tld-bench"], cwd=REPO)
+    if build.returncode != 0 or not bench.NATIVE_BIN.is_file():
+        raise SystemExit("models.py: cargo build --release -p tld-bench failed")
     fi = bench.FmuInfo(FMU)
     scenes = [sc for sc in bench.make_scenes(False) if sc.kind == "open"]
     # A wind-level scene, where the hardening is small: the benchmark's scenes are all strongly

@@ -10,6 +10,8 @@ Modules (imported on demand; none is loaded by importing the package):
   sdof       the Table 2.1 structure and its co-simulation master (scripts/demo.py, fig25.py)
   building   an N-storey shear building master with TLD.fmu instances (scripts/building.py)
   study      design studies on dask.distributed (scripts/sweep.py)
+  peaks      a response peak located to a stated tolerance by golden-section search from a sweep's
+             grid (scripts/demo.py, building.py, fig25.py, study)
   scenes     the work-precision benchmark's scenes, references and job lines (bench/python/bench.py,
              scripts/models.py)
 """

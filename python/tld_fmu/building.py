@@ -39,6 +39,12 @@ class Building:
         self.minv = 1.0 / m
         self.omega1 = w[0]
 
+    def steady_amplitudes(self, w, ground_amplitude):
+        """Steady-state displacement amplitudes of the floors (relative to the ground) under
+        x_g = ground_amplitude sin(w t), in closed form: (K - w^2 M + i w C) X = w^2 A_g M 1."""
+        Z = self.K - w * w * self.M + 1j * w * self.C
+        return np.abs(np.linalg.solve(Z, w * w * ground_amplitude * np.diag(self.M)))
+
     def accel(self, X, V, F, ag):
         return self.minv * (F - self.C @ V - self.K @ X) - ag
 

@@ -10,9 +10,17 @@ task. Each worker keeps its FMU instances and reuses them through fmi2Reset. The
 
 The FMU travels to the workers as data (scattered once); the workers of a LocalCluster import
 this package from the venv, those of an existing scheduler get it uploaded (a zip), so a remote
-cluster needs only numpy and fmpy installed. Writes one CSV table (a row per run) and heat maps
-of the peak amplification (max over frequency of the steady structure displacement / ground
-displacement) over tuning x mass ratio, one panel per amplitude.
+cluster needs only numpy and fmpy installed.
+
+The peak over frequency of each case (tuning x tanks x amplitude) is refined (tld_fmu.peaks):
+the frequency grid brackets the largest response and a golden-section search of further runs,
+all cases in lockstep as dask tasks, locates it to +-xtol in w / w_s (--xtol, default 0.002).
+
+Writes, named after the study file STUDY.toml, into --out (default out/sweep): STUDY.csv (a row
+per run, the refinement runs included and marked), STUDY-peaks.csv (a row per case: the refined
+peak, the grid's, and the tolerance) and STUDY.png (heat maps of the refined peak amplification,
+max over frequency of the steady structure displacement / ground displacement, over tuning x mass
+ratio, one panel per amplitude, with the bare structure's value for reference).
 """
 from __future__ import annotations
 
@@ -31,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from . import building
+from . import peaks as pk
 from .paths import FMU, REPO
 COLUMNS = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "frequency_ratio", "omega_s",
            "peak_displacement", "amplification"]
@@ -182,36 +191,141 @@ def _package_zip(directory: Path) -> str:
 
 def write_table(rows: list[dict], path: Path):
     cols = COLUMNS + ["worker", "instances", "error"]
+    if any("refinement" in r for r in rows):
+        cols.append("refinement")
+        rows = [{"refinement": 0, **r} for r in rows]
     with open(path, "w") as fh:
         fh.write(",".join(cols) + "\n")
         for r in rows:
             fh.write(",".join(repr(r[c]) if isinstance(r[c], float) else str(r[c]) for c in cols) + "\n")
 
 
-def heat_maps(rows: list[dict], path: Path):
-    """Peak amplification (max over frequency) over tuning x mass ratio, a panel per amplitude."""
+def _case(r: dict) -> tuple:
+    return (r["tuning"], r["tanks"], r["ground_amplitude"])
+
+
+def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xtol: float = 2e-3,
+                 progress=True) -> tuple[list[dict], list[dict]]:
+    """The peak over frequency of every case of a study (tuning x tanks x amplitude), refined from
+    the grid runs `rows` (run_study's) by golden-section search to xtol in w / w_s; the searches of
+    all cases advance in lockstep, one round of runs at a time (dask tasks on a client, else
+    serially). Returns (peaks: a row per case, the refinement runs' rows). A case whose grid
+    has a failed run is not refined (its peak row says so)."""
+    fmu_bytes = Path(fmu_path).read_bytes()
+    digest = hashlib.sha256(fmu_bytes).hexdigest()
+    unzipdir, md, _ = _fmu_on_worker(fmu_bytes, digest)
+    runs = expand(study, unzipdir, md)
+    cases: dict[tuple, list[int]] = {}
+    for i, r in enumerate(runs):
+        cases.setdefault(_case(r), []).append(i)
+    curves = {c: ([runs[i]["frequency_ratio"] for i in idx], [rows[i]["amplification"] for i in idx])
+              for c, idx in cases.items() if not any(math.isnan(rows[i]["amplification"]) for i in idx)}
+    data = None
+    if client is not None:
+        data = client.scatter(fmu_bytes, broadcast=True, hash=False)
+    from tqdm import tqdm
+    bar = tqdm(desc="peak refinement runs", disable=not progress)
+    extra: list[dict] = []
+
+    def evaluate(batch):
+        todo = [{**runs[cases[c][0]], "frequency_ratio": float(x)} for c, x in batch]
+        if client is None:
+            got = []
+            for r in todo:
+                try:
+                    got.append(run_one(fmu_bytes, digest, study, r))
+                except Exception as e:
+                    got.append(failed_row(r, e))
+        else:
+            futures = client.map(run_one, [data] * len(todo), [digest] * len(todo), [study] * len(todo), todo,
+                                 pure=False)
+            got = [f.result() if f.status == "finished" else failed_row(r, f.exception())
+                   for f, r in zip(_wait(futures), todo)]
+        for g in got:
+            g["refinement"] = 1
+        extra.extend(got)
+        bar.update(len(batch))
+        return [g["amplification"] for g in got]
+
+    # every grid maximum within half of the largest: a tuned damper's two peaks, either of which
+    # may turn out the higher once refined
+    found = pk.refine_curves(curves, evaluate, xtol, every=True, rel=0.5)
+    bar.close()
+    out = []
+    for c, idx in cases.items():
+        first = rows[idx[0]]
+        base = {k: first[k] for k in ("tuning", "tanks", "mass_ratio", "ground_amplitude")}
+        if c not in found:
+            out.append({**base, "peak_frequency_ratio": math.nan, "peak_amplification": math.nan, "xtol": xtol,
+                        "grid_frequency_ratio": math.nan, "grid_amplification": math.nan, "bounded": False,
+                        "refinement_runs": 0, "note": "a grid run failed: not refined"})
+            continue
+        p = pk.highest(found[c])
+        out.append({**base, "peak_frequency_ratio": p.x, "peak_amplification": p.y, "xtol": xtol,
+                    "grid_frequency_ratio": p.grid_x, "grid_amplification": p.grid_y, "bounded": p.bounded,
+                    "refinement_runs": sum(len(q.points) for q in found[c]),
+                    "note": "" if p.bounded else "peak at the edge of the frequency range: widen it"})
+    return out, extra
+
+
+def _wait(futures):
+    from distributed import wait
+    wait(futures)
+    return futures
+
+
+PEAK_COLUMNS = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "peak_frequency_ratio", "peak_amplification",
+                "xtol", "grid_frequency_ratio", "grid_amplification", "bounded", "refinement_runs", "note"]
+
+
+def write_peaks(peaks: list[dict], path: Path):
+    with open(path, "w") as fh:
+        fh.write(",".join(PEAK_COLUMNS) + "\n")
+        for r in peaks:
+            fh.write(",".join(repr(r[c]) if isinstance(r[c], float) else str(r[c]) for c in PEAK_COLUMNS) + "\n")
+
+
+def bare_peak_amplification(zeta: float) -> float:
+    """The bare one-mode structure's largest steady |X| / A_g under x_g = A_g sin(w t), closed
+    form: max over r of r^2 / sqrt((1 - r^2)^2 + (2 zeta r)^2) = 1 / (2 zeta sqrt(1 - zeta^2))."""
+    return 1.0 / (2.0 * zeta * math.sqrt(1.0 - zeta * zeta))
+
+
+def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: str = ""):
+    """Refined peak amplification over tuning x mass ratio, a panel per amplitude; the bare
+    structure's (closed form, damping ratio zeta) for reference."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    tunings = sorted({r["tuning"] for r in rows})
-    ratios = sorted({r["mass_ratio"] for r in rows})
-    amps = sorted({r["ground_amplitude"] for r in rows})
-    fig, axes = plt.subplots(1, len(amps), figsize=(4.5 * len(amps), 3.8), squeeze=False)
+    tunings = sorted({r["tuning"] for r in peaks})
+    ratios = sorted({r["mass_ratio"] for r in peaks})
+    amps = sorted({r["ground_amplitude"] for r in peaks if not math.isnan(r["ground_amplitude"])})
+    fig, axes = plt.subplots(1, max(1, len(amps)), figsize=(4.8 * max(1, len(amps)), 4.4), squeeze=False)
+    bare = bare_peak_amplification(zeta) if zeta else None
     for ax, amp in zip(axes[0], amps):
         Z = np.full((len(ratios), len(tunings)), np.nan)
-        for r in rows:
+        edge = np.zeros_like(Z, dtype=bool)
+        for r in peaks:
             if r["ground_amplitude"] == amp:
                 i, j = ratios.index(r["mass_ratio"]), tunings.index(r["tuning"])
-                Z[i, j] = np.fmax(Z[i, j], r["amplification"])
+                Z[i, j], edge[i, j] = r["peak_amplification"], not r["bounded"]
         im = ax.imshow(Z, origin="lower", aspect="auto", cmap="viridis")
         ax.set_xticks(range(len(tunings)), [f"{t:.2f}" for t in tunings])
         ax.set_yticks(range(len(ratios)), [f"{100 * m:.2g} %" for m in ratios])
         for i, j in itertools.product(range(len(ratios)), range(len(tunings))):
-            ax.text(j, i, f"{Z[i, j]:.0f}", ha="center", va="center", color="w", fontsize=8)
+            text = f"{Z[i, j]:.0f}" + ("*" if edge[i, j] else "")
+            if bare:
+                text += f"\n{100 * (1 - Z[i, j] / bare):.0f} % less"
+            ax.text(j, i, text, ha="center", va="center", color="w", fontsize=7)
         ax.set_xlabel(r"tuning $\omega_f / \omega_s$")
         ax.set_ylabel("mass ratio")
-        ax.set_title(f"ground amplitude {amp * 1e3:g} mm")
+        ax.set_title(f"ground amplitude {amp * 1e3:g} mm", fontsize=10)
         fig.colorbar(im, ax=ax, label="peak |X| / ground amplitude")
+    head = f"{title}: " if title else ""
+    ref = (f"without dampers {bare:.0f} (closed form 1/(2 zeta sqrt(1 - zeta^2)), zeta = {100 * zeta:g} %)"
+           if bare else "")
+    fig.suptitle(f"{head}peak amplification over frequency, refined; {ref}\n"
+                 "* = at the edge of the frequency range (the peak may lie outside)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -224,7 +338,10 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2, help="LocalCluster worker processes (default 2)")
     ap.add_argument("--serial", action="store_true", help="no dask: run here, one instance pool")
     ap.add_argument("--fmu", default=str(FMU))
-    ap.add_argument("--out", default=str(REPO / "out" / "sweep"))
+    ap.add_argument("--out", default=str(REPO / "out" / "sweep"),
+                    help="directory for STUDY.csv, STUDY-peaks.csv and STUDY.png (default out/sweep)")
+    ap.add_argument("--xtol", type=float, default=2e-3,
+                    help="tolerance of the refined peak frequencies, in w / w_s (default 0.002)")
     args = ap.parse_args(argv)
     study = tomllib.loads(Path(args.study).read_text())
     out = Path(args.out)
@@ -234,13 +351,19 @@ def main(argv=None):
         client, cluster = connect(args.scheduler, args.workers)
     try:
         rows, wall = run_study(study, Path(args.fmu), client)
+        t0 = time.perf_counter()
+        peaks, extra = refine_study(study, Path(args.fmu), rows, client, args.xtol)
+        wall_refine = time.perf_counter() - t0
     finally:
         if client is not None:
             client.close()
         if cluster is not None:
             cluster.close()
-    write_table(rows, out / "study.csv")
-    heat_maps(rows, out / "study.png")
+    name = Path(args.study).stem
+    table, peaks_file, png = out / f"{name}.csv", out / f"{name}-peaks.csv", out / f"{name}.png"
+    write_table(rows + extra, table)
+    write_peaks(peaks, peaks_file)
+    heat_maps(peaks, png, study["structure"].get("damping"), name)
     where = "serial" if args.serial else (args.scheduler or f"LocalCluster, {args.workers} workers")
     failed = [r for r in rows if r["error"]]
     if failed:
@@ -248,5 +371,7 @@ def main(argv=None):
               f"first: {failed[0]['error']}")
     print(f"{len(rows)} runs in {wall:.1f} s ({len(rows) / wall:.2f} runs/s, {where}); "
           f"{len({r['worker'] for r in rows})} worker threads, at most {max(r['instances'] for r in rows)} "
-          f"FMU instance(s) each; wrote {out}/study.csv, study.png")
+          f"FMU instance(s) each; then {len(extra)} refinement runs in {wall_refine:.1f} s "
+          f"(peaks to +-{args.xtol:g} w_s)")
+    print(f"wrote {table}, {peaks_file}, {png}")
     return rows

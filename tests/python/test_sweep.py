@@ -68,20 +68,51 @@ def test_existing_scheduler_by_address_writes_table_and_heat_maps(fmu_path, refe
     study_file.write_text(toml(STUDY))
     with LocalCluster(n_workers=1, threads_per_worker=2, processes=True, dashboard_address=":0") as cluster:
         rows = sweep.main([str(study_file), "--scheduler", cluster.scheduler_address,
-                           "--fmu", str(fmu_path), "--out", str(tmp_path / "out")])
+                           "--fmu", str(fmu_path), "--out", str(tmp_path / "out"), "--xtol", "0.01"])
     assert_same(rows, reference)
     table = np.genfromtxt(tmp_path / "out" / "study.csv", delimiter=",", names=True, dtype=None, encoding=None)
-    assert len(table) == 12
-    assert np.array_equal(table["peak_displacement"], [r["peak_displacement"] for r in reference])
+    grid = table[table["refinement"] == 0]
+    assert len(grid) == 12
+    assert np.array_equal(grid["peak_displacement"], [r["peak_displacement"] for r in reference])
     assert (tmp_path / "out" / "study.png").stat().st_size > 10_000
+    assert_peaks_refined(table, tmp_path / "out" / "study-peaks.csv", 0.01)
+
+
+def assert_peaks_refined(table, peaks_file, xtol):
+    """Each case's reported peak is the best of its grid and refinement runs, at least the grid's,
+    and the refinement ran where the grid brackets a maximum."""
+    peaks = np.genfromtxt(peaks_file, delimiter=",", names=True, dtype=None, encoding=None)
+    assert len(peaks) == 4
+    for p in peaks:
+        case = (table["tuning"] == p["tuning"]) & (table["tanks"] == p["tanks"]) \
+            & (table["ground_amplitude"] == p["ground_amplitude"])
+        assert p["peak_amplification"] == table["amplification"][case].max()
+        assert p["peak_amplification"] >= p["grid_amplification"] and p["xtol"] == xtol
+        if p["bounded"]:
+            assert p["refinement_runs"] >= 3 and abs(p["peak_frequency_ratio"] - p["grid_frequency_ratio"]) <= 0.1
+        else:
+            assert "edge" in p["note"]
+    assert any(peaks["bounded"])
 
 
 def test_serial_mode_reuses_one_instance(fmu_path, reference, tmp_path):
     study_file = tmp_path / "study.toml"
     study_file.write_text(toml(STUDY))
-    rows = sweep.main([str(study_file), "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path)])
+    rows = sweep.main([str(study_file), "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path), "--xtol", "0.01"])
     assert_same(rows, reference)
     assert len({r["worker"] for r in rows}) == 1 and max(r["instances"] for r in rows) == 1
+
+
+def test_outputs_are_named_after_the_study_file(fmu_path, tmp_path):
+    """Two studies in one output directory do not overwrite each other's results."""
+    small = {**STUDY, "study": {**STUDY["study"], "tuning": [1.0], "tanks": [1]}}
+    for name in ("tall_building", "small_tank"):
+        (tmp_path / f"{name}.toml").write_text(toml(small))
+        sweep.main([str(tmp_path / f"{name}.toml"), "--serial", "--fmu", str(fmu_path), "--out",
+                    str(tmp_path / "out"), "--xtol", "0.02"])
+    written = sorted(p.name for p in (tmp_path / "out").iterdir())
+    assert written == ["small_tank-peaks.csv", "small_tank.csv", "small_tank.png",
+                       "tall_building-peaks.csv", "tall_building.csv", "tall_building.png"]
 
 
 def toml(d: dict) -> str:
