@@ -14,7 +14,7 @@ use tld_fmu::physics::laws::nsd_kappa;
 /// frequency), follows the data, and the NSD damping law zeta = c Lambda^p to the damping data
 /// (c, p are the FMU's nsd.c, nsd.p). Prints the fit and the residuals per sample.
 ///
-/// Without --data: the NSD laws of MODEL.md (kappa = 1.075 Lambda^0.007 below Lambda = 0.03,
+/// Without --data: the NSD laws of docs/MODEL.md (kappa = 1.075 Lambda^0.007 below Lambda = 0.03,
 /// 2.52 Lambda^0.25 above; zeta = 0.5 Lambda^0.35) at --points values of Lambda spaced
 /// logarithmically over [--from, --to].
 #[derive(Parser, Debug)]
