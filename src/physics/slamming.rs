@@ -301,4 +301,196 @@ mod tests {
         assert_eq!(st.contact, 0);
         assert!(st.v < 0.0 && st.z < 0.05, "{st:?}");
     }
+
+    /// z(t) of free flight from (z0, v0) at t = 0 under a_b = a0 + a1 t + a2 t^2/2, written out
+    /// as its own polynomial (the reference for the stepped flight).
+    fn quartic(a: [f64; 3], z0: f64, v0: f64, t: f64) -> (f64, f64) {
+        let z = z0 + v0 * t - a[0] * t * t / 2.0 - a[1] * t * t * t / 6.0 - a[2] * t.powi(4) / 24.0;
+        let v = v0 - a[0] * t - a[1] * t * t / 2.0 - a[2] * t * t * t / 6.0;
+        (z, v)
+    }
+
+    /// Polynomials in z of magnitude ~0.1 with O(1) coefficients round to ~1e-17; every
+    /// comparison with the closed form below allows 1e-14, a thousand times that, and still
+    /// sees any wrong coefficient (the mutants change z by 1e-3 or more).
+    const TOL: f64 = 1e-14;
+
+    /// Guards p2 (a[1]/6, a[2]/24) and the flight from a mid-step start: a changing base
+    /// acceleration (nonzero first and second derivative), one step with no impact, and one in
+    /// which the mass hits the wall and flies on; both against the closed-form quartic, the
+    /// impact time against a Newton root of that quartic.
+    #[test]
+    fn flight_under_a_changing_input_follows_the_quartic() {
+        let m = Slamming {
+            clearance: 1.0,
+            restitution: 0.5,
+            rest_speed: 1e-6,
+        };
+        let a = [0.7, -2.3, 5.1];
+        let base = BaseAcceleration { t0: 0.0, a };
+        let mut st = SlamState {
+            z: 0.1,
+            v: -0.2,
+            ..Default::default()
+        };
+        let h = 0.6;
+        m.advance(&mut st, h, &base).expect("step");
+        let (z, v) = quartic(a, 0.1, -0.2, h);
+        assert_eq!(st.impacts, 0, "{st:?}");
+        assert!(
+            (st.z - z).abs() < TOL && (st.v - v).abs() < TOL,
+            "{st:?} vs {z} {v}"
+        );
+
+        // From rest at the centre the input -a pushes the mass to the +wall (z = 0.5) at t1.
+        let a = [-4.0, -3.0, 2.0];
+        let base = BaseAcceleration { t0: 0.0, a };
+        let mut t1 = 0.4;
+        for _ in 0..50 {
+            let (z, v) = quartic(a, 0.0, 0.0, t1);
+            t1 -= (z - 0.5) / v;
+        }
+        let mut st = SlamState::default();
+        let h = 0.55;
+        let impulse = m.advance(&mut st, h, &base).expect("step");
+        assert_eq!(st.impacts, 1, "{st:?}");
+        let (_, v_hit) = quartic(a, 0.0, 0.0, t1);
+        // After the impact: from (0.5, -e v_hit) at t1 under the same input, i.e. the quartic
+        // with the input re-expanded about t1.
+        let shifted = [
+            a[0] + a[1] * t1 + a[2] * t1 * t1 / 2.0,
+            a[1] + a[2] * t1,
+            a[2],
+        ];
+        let (z, v) = quartic(shifted, 0.5, -0.5 * v_hit, h - t1);
+        assert!(
+            (st.z - z).abs() < TOL && (st.v - v).abs() < TOL,
+            "{st:?} vs {z} {v}"
+        );
+        assert!(
+            (impulse - 1.5 * v_hit).abs() < TOL,
+            "{impulse} vs {}",
+            1.5 * v_hit
+        );
+    }
+
+    /// A mass resting on `wall` under a ramp a_b = a0 + a1 s that stops pressing it there at
+    /// s* = -a0/a1 inside the step, with |a_b| < 1 m/s^2 throughout: it must stay until s*
+    /// (pushing on the tank with -a_b), then fly off from rest. Guards the release test's sign
+    /// (a_b wall > 0; a_b + wall > 0 releases at once from the +1 wall and never from the -1
+    /// wall) and where the release lands.
+    #[test]
+    fn ramped_input_turning_on_a_wall_releases_at_its_root() {
+        let m = slam(0.5);
+        for wall in [1i8, -1] {
+            let w = f64::from(wall);
+            let a = [-0.5 * w, 1.6 * w, 0.0];
+            let base = BaseAcceleration { t0: 0.0, a };
+            let s_star = 0.5 / 1.6;
+            let h = 0.5;
+            let mut st = SlamState {
+                z: 0.05 * w,
+                contact: wall,
+                ..Default::default()
+            };
+            let impulse = m.advance(&mut st, h, &base).expect("step");
+            assert_eq!(st.contact, 0, "wall {wall}: {st:?}");
+            assert_eq!(st.impacts, 0, "wall {wall}: {st:?}");
+            // While resting: impulse -int a; the input has a root at s*, so it is the input's
+            // integral up to there.
+            let rest = -(a[0] * s_star + a[1] * s_star * s_star / 2.0);
+            assert!(
+                (impulse - rest).abs() < TOL,
+                "wall {wall}: {impulse} vs {rest}"
+            );
+            let shifted = [0.0, a[1], 0.0];
+            let (z, v) = quartic(shifted, 0.05 * w, 0.0, h - s_star);
+            assert!(
+                (st.z - z).abs() < TOL && (st.v - v).abs() < TOL,
+                "wall {wall}: {st:?} vs {z} {v}"
+            );
+        }
+    }
+
+    /// Weak held accelerations (0.3 m/s^2) on each wall: pressing keeps the mass there for the
+    /// whole step, pulling releases it at once. Guards the release sign for |a_b| < 1, where
+    /// a_b + wall has the sign of the wall, not of a_b wall.
+    #[test]
+    fn weak_inputs_press_or_release_on_each_wall() {
+        let m = slam(0.5);
+        for wall in [1i8, -1] {
+            let w = f64::from(wall);
+            for (a, stays) in [(-0.3 * w, true), (0.3 * w, false)] {
+                let mut st = SlamState {
+                    z: 0.05 * w,
+                    contact: wall,
+                    ..Default::default()
+                };
+                let h = 0.2;
+                let impulse = m
+                    .advance(&mut st, h, &BaseAcceleration::held(a))
+                    .expect("step");
+                if stays {
+                    assert_eq!((st.contact, st.z, st.v), (wall, 0.05 * w, 0.0), "{st:?}");
+                    assert!((impulse + a * h).abs() < TOL, "{impulse}");
+                } else {
+                    assert_eq!(st.contact, 0, "wall {wall} a {a}: {st:?}");
+                    assert_eq!(impulse, 0.0);
+                    assert!((st.v + a * h).abs() < TOL, "{st:?}");
+                    assert!((st.z - (0.05 * w - a * h * h / 2.0)).abs() < TOL, "{st:?}");
+                }
+            }
+        }
+    }
+
+    /// The release time alone, against the root of the quadratic input by the quadratic
+    /// formula. The bisection ends within an ulp of the place where the computed a_b changes
+    /// sign, which lies within rounding of a_b (~1e-16) over its slope (~1) of the true root:
+    /// 1e-14 allows a hundred times that; a search stopped at the 1/64 grid is 1e-3 off.
+    #[test]
+    fn release_time_is_the_root_of_the_input() {
+        let a = [-0.8, 0.9, 1.7];
+        let base = BaseAcceleration { t0: 0.0, a };
+        // a0 + a1 s + a2 s^2 / 2 = 0, the positive root.
+        let (qa, qb, qc) = (a[2] / 2.0, a[1], a[0]);
+        let root = (-qb + (qb * qb - 4.0 * qa * qc).sqrt()) / (2.0 * qa);
+        let (s0, s1) = (0.1, 0.9);
+        assert!(root > s0 && root < s1);
+        let got = Slamming::release(&base, 1, s0, s1).expect("releases");
+        assert!((got - root).abs() < TOL, "{got} vs {root}");
+        // Beyond the root the input presses the -1 wall throughout and pulls from the +1 wall
+        // at once; before it, the reverse.
+        assert_eq!(Slamming::release(&base, -1, root + 1e-3, s1), None);
+        assert_eq!(Slamming::release(&base, -1, s0, s1), Some(s0));
+        assert_eq!(
+            Slamming::release(&base, 1, root + 1e-3, s1),
+            Some(root + 1e-3)
+        );
+    }
+
+    /// Chattering may take up to MAX_IMPACTS_PER_STEP impacts in one step, not one fewer:
+    /// elastic bounces at 1 m/s across d = 0.1 hit a wall at 0.05 + 0.1 k s, so a step of
+    /// 10000 s holds exactly 100000 impacts (the next one 0.05 s later), and one of 10000.1 s
+    /// one more. Guards the comparison against the limit (> not >=).
+    #[test]
+    fn impact_limit_is_exact() {
+        let m = Slamming {
+            clearance: 0.1,
+            restitution: 1.0,
+            rest_speed: 1e-6,
+        };
+        let start = SlamState {
+            v: 1.0,
+            ..Default::default()
+        };
+        let mut st = start;
+        m.advance(&mut st, 10_000.0, &BaseAcceleration::held(0.0))
+            .expect("exactly at the limit");
+        assert_eq!(st.impacts, MAX_IMPACTS_PER_STEP);
+        let mut st = start;
+        assert!(
+            m.advance(&mut st, 10_000.1, &BaseAcceleration::held(0.0))
+                .is_err()
+        );
+    }
 }
