@@ -447,6 +447,7 @@ mod tests {
     /// formula. The bisection ends within an ulp of the place where the computed a_b changes
     /// sign, which lies within rounding of a_b (~1e-16) over its slope (~1) of the true root:
     /// 1e-14 allows a hundred times that; a search stopped at the 1/64 grid is 1e-3 off.
+    /// Also guards the grid staying inside the interval.
     #[test]
     fn release_time_is_the_root_of_the_input() {
         let a = [-0.8, 0.9, 1.7];
@@ -462,6 +463,8 @@ mod tests {
         // at once; before it, the reverse.
         assert_eq!(Slamming::release(&base, -1, root + 1e-3, s1), None);
         assert_eq!(Slamming::release(&base, -1, s0, s1), Some(s0));
+        // A root just after the interval is not in it (the search must stay inside (s0, s1]).
+        assert_eq!(Slamming::release(&base, 1, s0, root - 1e-3), None);
         assert_eq!(
             Slamming::release(&base, 1, root + 1e-3, s1),
             Some(root + 1e-3)
