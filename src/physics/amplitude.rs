@@ -211,4 +211,53 @@ mod tests {
             assert!(err.abs() < MEAN_TOL, "w/wf {ratio}: mean error {err:e}");
         }
     }
+
+    /// Guards the normalisation by the filters' response to a constant (the `/ w` of both mean
+    /// squares): with a constant acceleration and velocity the normalised means are exactly
+    /// a^2 and v^2 from the first update on, so the estimate is sqrt(2) v^2/|a| to rounding,
+    /// while the filters themselves hold only 1 - e^(-t/tau) of it (and the square of that).
+    #[test]
+    fn estimate_is_normalised_from_the_first_update() {
+        let mut tracker = AmplitudeTracker::new(2.0, 0.3, 0.001);
+        let (a, v) = (-0.8, 0.05);
+        let want = std::f64::consts::SQRT_2 * v * v / 0.8;
+        for k in 1..=20 {
+            tracker.update(0.05, a, v);
+            let got = tracker.estimate();
+            assert!(
+                (got / want - 1.0).abs() < 1e-14,
+                "update {k}: {got} vs {want}"
+            );
+        }
+    }
+
+    /// From base.a alone the rebuilt velocity starts at rest, so after the first update only
+    /// the acceleration has a mean square: no amplitude follows from that (the estimate stays
+    /// the prior, not 0). Guards the v2 > 0 half of the guard (>= or || would answer 0).
+    #[test]
+    fn no_estimate_before_the_rebuilt_velocity_moves() {
+        let mut tracker = AmplitudeTracker::new(2.0, 0.3, 0.001);
+        tracker.update(0.05, -0.8, 0.0);
+        assert_eq!(tracker.estimate(), 0.001);
+        tracker.update(0.05, -0.8, 0.0);
+        assert!(tracker.estimate() != 0.001 && tracker.estimate() > 0.0);
+    }
+
+    /// Guards the checks of a restored state: a fresh tracker's (zero) state is accepted, and
+    /// each bad value alone (not finite, a negative mean square, a flag not 0 or 1) refused.
+    #[test]
+    fn restored_state_is_checked_value_by_value() {
+        let mut tracker = AmplitudeTracker::new(2.0, 0.3, 0.001);
+        let fresh = tracker.state();
+        assert!(tracker.set_state(&fresh).is_ok());
+        tracker.update(0.05, -0.8, 0.05);
+        let good = tracker.state();
+        assert!(tracker.set_state(&good).is_ok());
+        assert_eq!(tracker.state(), good);
+        for (i, bad) in [(0, f64::NAN), (3, f64::INFINITY), (4, -1e-12), (1, 0.5)] {
+            let mut s = good;
+            s[i] = bad;
+            assert!(tracker.set_state(&s).is_err(), "state[{i}] = {bad}");
+        }
+    }
 }
