@@ -496,4 +496,68 @@ mod tests {
                 .is_err()
         );
     }
+
+    /// Guards the sampling density of the impact search (amax, vmax, resolution, n): the
+    /// search promises to see any crossing of the wall that lasts longer than one sample
+    /// interval, at most r = 0.01 d / vmax. Here the mass is thrown at the +wall against a held
+    /// a_b = 2 m/s^2 so that it passes the wall by only delta = a (0.525 r)^2 / 2 and is
+    /// beyond it for 1.05 r, just more than the promise. Over 40 step lengths (the grid's
+    /// phase against the graze moves) every graze must be an impact at the root of the
+    /// parabola; a grid 1.3 times as coarse (r = 0.01 d vmax here) misses some.
+    #[test]
+    fn grazes_of_the_wall_are_not_stepped_over() {
+        let m = slam(0.5);
+        let accel = 2.0;
+        for i in 0..40 {
+            let h = 0.3 + 0.005 * f64::from(i);
+            let v_nominal = (2.0 * accel * 0.05f64).sqrt();
+            let r = 0.01 * 0.1 / (v_nominal + accel * h);
+            let delta = accel * (0.525 * r).powi(2) / 2.0;
+            let v0 = (2.0 * accel * (0.05 + delta)).sqrt();
+            let mut st = SlamState {
+                v: v0,
+                ..Default::default()
+            };
+            m.advance(&mut st, h, &BaseAcceleration::held(accel))
+                .expect("step");
+            assert_eq!(
+                st.impacts, 1,
+                "h {h}: the graze by {delta:e} m was missed: {st:?}"
+            );
+            // Reaches the wall with v^2 = v0^2 - 2 a d/2 = 2 a delta, rebounds with e.
+            let v_hit = (2.0 * accel * delta).sqrt();
+            let t_hit = (v0 - v_hit) / accel;
+            let (z, v) = quartic([accel, 0.0, 0.0], 0.05, -0.5 * v_hit, h - t_hit);
+            // A graze is crossed at the slow v_hit: the rounding of z (< 1e-16 here) moves the
+            // root by 1e-16 / v_hit, and the state after it by (|v| + a) times that <= 3x.
+            let tol = 3e-16 / v_hit;
+            assert!(
+                (st.z - z).abs() < tol && (st.v - v).abs() < tol,
+                "h {h}: {st:?} vs {z} {v}"
+            );
+        }
+    }
+
+    /// Guards the search's upper end after a mid-step impact: elastic bounces at 0.2 m/s
+    /// across d = 0.1 hit at 0.25 s and 0.75 s; a step of 0.6 s holds the first only (a grid
+    /// reaching past s1 from s0 = 0.25 would take the second early).
+    #[test]
+    fn an_impact_after_the_step_is_not_taken_early() {
+        let m = Slamming {
+            clearance: 0.1,
+            restitution: 1.0,
+            rest_speed: 1e-6,
+        };
+        let mut st = SlamState {
+            v: 0.2,
+            ..Default::default()
+        };
+        m.advance(&mut st, 0.6, &BaseAcceleration::held(0.0))
+            .expect("step");
+        assert_eq!(st.impacts, 1, "{st:?}");
+        assert!(
+            (st.z - (0.05 - 0.2 * 0.35)).abs() < TOL && st.v == -0.2,
+            "{st:?}"
+        );
+    }
 }
