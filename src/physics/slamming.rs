@@ -613,4 +613,35 @@ mod tests {
             }
         }
     }
+
+    /// Chattering under weak and strong pressing on each wall (|a_b| = 0.5 and 1.5 m/s^2) must
+    /// end with the mass at rest there, and by momentum the tank has taken v0 + |a_b| t.
+    /// Guards the test of a pressing input at an impact (a_b wall <= 0): with a_b + wall <= 0
+    /// a weak press on +1 (or a strong one on -1) never lets the mass rest, and the bounces
+    /// shrink towards infinitely many.
+    #[test]
+    fn chattering_under_weak_and_strong_pressing_ends_at_rest() {
+        let m = slam(0.5);
+        for wall in [1i8, -1] {
+            let w = f64::from(wall);
+            for press in [0.5, 1.5] {
+                let mut st = SlamState {
+                    z: 0.04 * w,
+                    v: 0.3 * w,
+                    ..Default::default()
+                };
+                let impulse = m
+                    .advance(&mut st, 2.0, &BaseAcceleration::held(-press * w))
+                    .expect("chattering ends");
+                assert_eq!(st.contact, wall, "wall {wall} press {press}: {st:?}");
+                let want = w * (0.3 + press * 2.0);
+                // Momentum is exact at each impact and while resting: a few dozen impacts
+                // round to ~1e-14.
+                assert!(
+                    (impulse - want).abs() < 1e-12,
+                    "wall {wall} press {press}: {impulse} vs {want}"
+                );
+            }
+        }
+    }
 }
