@@ -569,48 +569,63 @@ mod tests {
     /// term bends the parabola by a1 r / a(t_p)); the impact time is bisected on the quartic.
     #[test]
     fn grazes_under_a_ramp_are_not_stepped_over() {
-        let m = slam(0.5);
         for a in [[0.5, 4.0, 0.0], [0.5, 2.0, 8.0]] {
-            let base = BaseAcceleration { t0: 0.0, a };
-            let t_p = 0.2;
-            let v0 = a[0] * t_p + a[1] * t_p * t_p / 2.0 + a[2] * t_p.powi(3) / 6.0;
-            let at = |t: f64| [a[0] + a[1] * t + a[2] * t * t / 2.0, a[1] + a[2] * t, a[2]];
-            let curvature = at(t_p)[0];
-            for i in 0..40 {
-                let h = 0.3 + 0.005 * f64::from(i);
-                let amax = a[0] + h * (a[1] + h * a[2]);
-                let r = 0.01 * 0.1 / (v0 + amax * h);
-                let delta = curvature * (0.525 * r).powi(2) / 2.0;
-                let (rise, _) = quartic(a, 0.0, v0, t_p);
-                let z0 = 0.05 + delta - rise;
-                let mut st = SlamState {
-                    z: z0,
-                    v: v0,
-                    ..Default::default()
-                };
-                m.advance(&mut st, h, &base).expect("step");
-                assert_eq!(
-                    st.impacts, 1,
-                    "{a:?} h {h}: graze by {delta:e} m missed: {st:?}"
-                );
-                let (mut lo, mut hi) = (t_p - r, t_p);
-                for _ in 0..100 {
-                    let mid = 0.5 * (lo + hi);
-                    if quartic(a, z0, v0, mid).0 < 0.05 {
-                        lo = mid
-                    } else {
-                        hi = mid
-                    }
+            graze_under(0.1, a, 0.2, 0.3);
+        }
+        // Steps of 2.5-4.1 s in a tank of 40 m, where h |a1| exceeds h + |a1|: a bound that
+        // added where it should multiply would be too small only there.
+        graze_under(40.0, [0.5, 4.0, 0.0], 2.0, 2.5);
+    }
+
+    /// One case of `grazes_under_a_ramp_are_not_stepped_over`: clearance d, input a, peak at
+    /// t_p, 40 step lengths from h0 on.
+    fn graze_under(d: f64, a: [f64; 3], t_p: f64, h0: f64) {
+        let m = Slamming {
+            clearance: d,
+            restitution: 0.5,
+            rest_speed: 1e-6,
+        };
+        let half = d / 2.0;
+        let base = BaseAcceleration { t0: 0.0, a };
+        let v0 = a[0] * t_p + a[1] * t_p * t_p / 2.0 + a[2] * t_p.powi(3) / 6.0;
+        let at = |t: f64| [a[0] + a[1] * t + a[2] * t * t / 2.0, a[1] + a[2] * t, a[2]];
+        let curvature = at(t_p)[0];
+        for i in 0..40 {
+            let h = h0 + h0 / 60.0 * f64::from(i);
+            let amax = a[0] + h * (a[1] + h * a[2]);
+            let r = 0.01 * d / (v0 + amax * h);
+            let delta = curvature * (0.525 * r).powi(2) / 2.0;
+            let (rise, _) = quartic(a, 0.0, v0, t_p);
+            let z0 = half + delta - rise;
+            assert!(z0.abs() < half);
+            let mut st = SlamState {
+                z: z0,
+                v: v0,
+                ..Default::default()
+            };
+            m.advance(&mut st, h, &base).expect("step");
+            assert_eq!(
+                st.impacts, 1,
+                "{a:?} h {h}: graze by {delta:e} m missed: {st:?}"
+            );
+            let (mut lo, mut hi) = (t_p - r, t_p);
+            for _ in 0..100 {
+                let mid = 0.5 * (lo + hi);
+                if quartic(a, z0, v0, mid).0 < half {
+                    lo = mid
+                } else {
+                    hi = mid
                 }
-                let (_, v_hit) = quartic(a, z0, v0, hi);
-                let (z, v) = quartic(at(hi), 0.05, -0.5 * v_hit, h - hi);
-                // As in the held case: the root is known to the rounding of z over v_hit.
-                let tol = 3e-16 / v_hit;
-                assert!(
-                    (st.z - z).abs() < tol && (st.v - v).abs() < tol,
-                    "{a:?} h {h}: {st:?} vs {z} {v}"
-                );
             }
+            let (_, v_hit) = quartic(a, z0, v0, hi);
+            let (z, v) = quartic(at(hi), half, -0.5 * v_hit, h - hi);
+            // As in the held case: the root is known to the rounding of z over v_hit, here
+            // z up to d/2 and the state after it moving at up to |v| + a.
+            let tol = 3e-16 * d / 0.1 * (1.0 + v.abs()) / v_hit;
+            assert!(
+                (st.z - z).abs() < tol && (st.v - v).abs() < tol,
+                "{a:?} h {h}: {st:?} vs {z} {v}"
+            );
         }
     }
 
