@@ -209,8 +209,15 @@ mod tests {
     /// double root: 1e-9 is wide.
     #[test]
     fn kappa_model_of_the_linear_law_is_the_exact_peak() {
-        for (lambda, zeta) in [(0.004, 0.02), (0.03, 0.08), (0.1, 0.2)] {
-            let k = kappa_model(5.6389, 0.25, 0.0, 2.0, lambda, zeta).expect("peak");
+        // The last case, a 10 m tank with its peak X = A / (2 zeta) at 2.5 tank lengths, checks
+        // that the peak is searched up to 3 tank lengths (3 + length or 3 / length is short).
+        for (length, lambda, zeta) in [
+            (0.25, 0.004, 0.02),
+            (0.25, 0.03, 0.08),
+            (0.25, 0.1, 0.2),
+            (10.0, 0.1, 0.02),
+        ] {
+            let k = kappa_model(5.6389, length, 0.0, 2.0, lambda, zeta).expect("peak");
             let want = 1.0 / (1.0 - 2.0 * zeta * zeta).sqrt();
             assert!(
                 (k / want - 1.0).abs() < 1e-9,
