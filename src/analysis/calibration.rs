@@ -173,6 +173,13 @@ mod tests {
             fit.kappa_residuals.iter().all(|r| r.abs() < 1e-5),
             "{fit:?}"
         );
+        // The damping law is fitted exactly (logs of a power law): its residuals vanish to
+        // rounding, and there is one per sample.
+        assert_eq!(fit.zeta_residuals.len(), samples.len());
+        assert!(
+            fit.zeta_residuals.iter().all(|r| r.abs() < 1e-12),
+            "{fit:?}"
+        );
     }
 
     /// Guards `nelder_mead` on a quadratic with a known minimum (1, -2) of value 3, where it
