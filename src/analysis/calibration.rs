@@ -173,5 +173,63 @@ mod tests {
             fit.kappa_residuals.iter().all(|r| r.abs() < 1e-5),
             "{fit:?}"
         );
+        // The damping law is fitted exactly (logs of a power law): its residuals vanish to
+        // rounding, and there is one per sample.
+        assert_eq!(fit.zeta_residuals.len(), samples.len());
+        assert!(
+            fit.zeta_residuals.iter().all(|r| r.abs() < 1e-12),
+            "{fit:?}"
+        );
+    }
+
+    /// Guards `nelder_mead` on a quadratic with a known minimum (1, -2) of value 3, where it
+    /// stops once the simplex values agree to 1e-14 relative, so the point is within
+    /// sqrt(3e-14 / smallest curvature) ~ 3e-7 of the minimum: allowed 1e-6.
+    #[test]
+    fn nelder_mead_finds_a_quadratics_minimum() {
+        let f = |q: [f64; 2]| {
+            let (x, y) = (q[0] - 1.0, q[1] + 2.0);
+            3.0 + x * x + 10.0 * y * y + x * y
+        };
+        let q = nelder_mead(f, [0.0, 0.0], [0.5, 0.5]);
+        assert!(
+            (q[0] - 1.0).abs() < 1e-6 && (q[1] + 2.0).abs() < 1e-6,
+            "{q:?}"
+        );
+    }
+
+    /// Guards `nelder_mead` on Rosenbrock's valley from the classic start (-1.2, 1): the
+    /// minimum (1, 1) has value 0, so only the 400 iterations stop it.
+    #[test]
+    fn nelder_mead_follows_the_rosenbrock_valley() {
+        let f = |q: [f64; 2]| (1.0 - q[0]).powi(2) + 100.0 * (q[1] - q[0] * q[0]).powi(2);
+        let q = nelder_mead(f, [-1.2, 1.0], [0.5, 0.5]);
+        assert!(
+            (q[0] - 1.0).abs() < 1e-6 && (q[1] - 1.0).abs() < 1e-6,
+            "{q:?}"
+        );
+    }
+
+    /// Guards `kappa_model` on the linear law (phi = 0): the peak of the base-excited
+    /// response w^2 A / |w_f^2 - w^2 + i D w| lies at w^2 = w_f^2 / (1 - 2 zeta^2), whatever
+    /// Lambda. The peak's frequency is the mean of the two merging roots, within ~eps of the
+    /// double root: 1e-9 is wide.
+    #[test]
+    fn kappa_model_of_the_linear_law_is_the_exact_peak() {
+        // The last case, a 10 m tank with its peak X = A / (2 zeta) at 2.5 tank lengths, checks
+        // that the peak is searched up to 3 tank lengths (3 + length or 3 / length is short).
+        for (length, lambda, zeta) in [
+            (0.25, 0.004, 0.02),
+            (0.25, 0.03, 0.08),
+            (0.25, 0.1, 0.2),
+            (10.0, 0.1, 0.02),
+        ] {
+            let k = kappa_model(5.6389, length, 0.0, 2.0, lambda, zeta).expect("peak");
+            let want = 1.0 / (1.0 - 2.0 * zeta * zeta).sqrt();
+            assert!(
+                (k / want - 1.0).abs() < 1e-9,
+                "{lambda} {zeta}: {k} vs {want}"
+            );
+        }
     }
 }

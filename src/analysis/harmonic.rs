@@ -270,4 +270,132 @@ mod tests {
             assert!(hb.residual(p.x, p.w).abs() < 1e-9 * scale, "{p:?}");
         }
     }
+
+    /// The linear oscillator's exact response to base motion A sin(w t):
+    /// X(w) = w^2 A / sqrt((w_f^2 - w^2)^2 + (D w)^2).
+    fn linear_case() -> (HarmonicBalance, impl Fn(f64) -> f64) {
+        let (wf, d, a) = (4.0, 2.0 * 0.03 * 4.0, 0.002);
+        let hb = HarmonicBalance {
+            law: PowerLaw::new(wf, 0.0, 2.0, 1.0),
+            damping: d,
+            base_amplitude: a,
+        };
+        let exact = move |w: f64| w * w * a / ((wf * wf - w * w).powi(2) + (d * w).powi(2)).sqrt();
+        (hb, exact)
+    }
+
+    /// Guards `frequencies` (both roots, the X = A case, the sorting) and `amplitudes` (the
+    /// bracketing and the stability flag) with the linear oscillator, whose balance is the
+    /// exact frequency response. Each root solves the balance to rounding (the quadratic in
+    /// w^2 is well separated away from the peak, the bisection ends at 1e-15 X), so 1e-10
+    /// relative is a wide margin; a wrong root is off by its whole distance to the other.
+    #[test]
+    fn linear_balance_is_the_exact_frequency_response() {
+        let (hb, exact) = linear_case();
+        for w in [0.5, 2.0, 3.7, 3.95, 4.0, 4.1, 5.0, 12.0] {
+            let got = hb.amplitudes(w, 10.0);
+            assert_eq!(got.len(), 1, "w {w}: {got:?}");
+            assert!(got[0].stable && got[0].w == w, "w {w}: {got:?}");
+            let want = exact(w);
+            assert!(
+                (got[0].x / want - 1.0).abs() < 1e-10,
+                "w {w}: {got:?} vs {want}"
+            );
+        }
+        let peak = hb.peak(10.0).expect("peak").x;
+        // Below A one (high) frequency, A itself the degenerate quadratic, then two up to the peak.
+        for (x, count) in [
+            (0.001, 1),
+            (0.002, 1),
+            (0.003, 2),
+            (0.02, 2),
+            (0.99 * peak, 2),
+        ] {
+            let ws = hb.frequencies(x);
+            assert_eq!(ws.len(), count, "X {x}: {ws:?}");
+            assert!(ws.windows(2).all(|p| p[0] < p[1]), "X {x}: {ws:?}");
+            for w in ws {
+                assert!((exact(w) / x - 1.0).abs() < 1e-10, "X {x}: w {w}");
+            }
+        }
+        assert!(hb.frequencies(1.01 * peak).is_empty());
+    }
+
+    /// Guards `backbone`: for eta = 2 Eq 2.13 is the cubic Duffing oscillator
+    /// x'' + w_f^2 x + k3 x^3 with k3 = w_f^2 phi (2/a)^2, whose first-order harmonic balance
+    /// backbone is w^2 = w_f^2 + (3/4) k3 X^2; for eta = 3 the quintic term gives (5/8) k5 X^4.
+    /// Closed forms in a few operations: 1e-14 relative.
+    #[test]
+    fn duffing_backbone_is_the_first_order_formula() {
+        let (wf, phi, a) = (5.6389f64, 0.7, 0.25);
+        let duffing = HarmonicBalance {
+            law: PowerLaw::new(wf, phi, 2.0, a),
+            damping: 0.1,
+            base_amplitude: 0.003,
+        };
+        let quintic = HarmonicBalance {
+            law: PowerLaw::new(wf, phi, 3.0, a),
+            ..duffing
+        };
+        let k3 = wf * wf * phi * (2.0 / a).powi(2);
+        let k5 = wf * wf * phi * (2.0 / a).powi(4);
+        for x in [0.0, 0.01, 0.05, 0.125, 0.2] {
+            let want3 = (wf * wf + 0.75 * k3 * x * x).sqrt();
+            let want5 = (wf * wf + 0.625 * k5 * x.powi(4)).sqrt();
+            assert!((duffing.backbone(x) / want3 - 1.0).abs() < 1e-14, "X {x}");
+            assert!((quintic.backbone(x) / want5 - 1.0).abs() < 1e-14, "X {x}");
+        }
+    }
+
+    /// Guards `fold` and `peak` by what they are: at the fold the balance has a double root in
+    /// X (F = 0 and dF/dX = 0, so F keeps its sign on both sides); at the peak the two
+    /// frequencies merge (two just below, none just above). The golden section locates the
+    /// fold's X to ~sqrt(eps) relative, far inside the 1e-3 offsets probed.
+    #[test]
+    fn fold_and_peak_are_where_solutions_merge() {
+        let hb = example();
+        let fold = hb.fold(1.0).expect("fold");
+        let scale = (fold.w * fold.w * hb.base_amplitude).powi(2);
+        assert!(hb.residual(fold.x, fold.w).abs() < 1e-9 * scale, "{fold:?}");
+        let (below, above) = (
+            hb.residual(fold.x * (1.0 - 1e-3), fold.w),
+            hb.residual(fold.x * (1.0 + 1e-3), fold.w),
+        );
+        assert!(below * above > 0.0, "{fold:?}: {below} {above}");
+        // And it is the lowest frequency of the high branch: just below it one amplitude,
+        // just above three.
+        assert_eq!(hb.amplitudes(fold.w * (1.0 - 1e-3), 0.25).len(), 1);
+        assert_eq!(hb.amplitudes(fold.w * (1.0 + 1e-3), 0.25).len(), 3);
+        let peak = hb.peak(1.0).expect("peak");
+        let near = hb.frequencies(peak.x * (1.0 - 1e-9));
+        assert_eq!(near.len(), 2, "{near:?}");
+        assert!(
+            near.iter().all(|w| (w / peak.w - 1.0).abs() < 1e-3),
+            "{near:?} {peak:?}"
+        );
+        assert!(hb.frequencies(peak.x * (1.0 + 1e-9)).is_empty());
+    }
+
+    /// Guards the stability flags of `curve`: a periodic solution is stable where the
+    /// balance rises through zero in X (dF/dX > 0), measured here by a central difference
+    /// away from the fold and the peak, where dF/dX vanishes.
+    #[test]
+    fn curve_stability_is_the_sign_of_the_slope() {
+        let hb = example();
+        let (fold, peak) = (hb.fold(1.0).expect("fold"), hb.peak(1.0).expect("peak"));
+        let mut unstable = 0;
+        for p in hb.curve(0.2, 300) {
+            if (p.x / fold.x - 1.0).abs() < 0.02 || (p.x / peak.x - 1.0).abs() < 0.02 {
+                continue;
+            }
+            let dx = 1e-6 * p.x;
+            let slope = hb.residual(p.x + dx, p.w) - hb.residual(p.x - dx, p.w);
+            assert_eq!(p.stable, slope > 0.0, "{p:?}: {slope}");
+            unstable += usize::from(!p.stable);
+        }
+        assert!(
+            unstable > 5,
+            "the middle branch must be sampled: {unstable}"
+        );
+    }
 }

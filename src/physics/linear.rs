@@ -328,4 +328,65 @@ mod tests {
             s.dissipated
         );
     }
+
+    /// Guards `tank_force`: what the mode pushes on the tank is what its own equation says,
+    /// F = -a_b - x''. Over a short step the momentum balance int F ds = -(v(h) - v(0)) - int a
+    /// is checked with Simpson's rule on F at 0, h/2, h (states from the exact propagator):
+    /// its error, h^5 max|F^(4)| / 2880 ~ (omega h)^4 |F| h / 2880 ~ 1e-9 |F| h here, is far
+    /// below the 1e-7 h allowed; a wrong damping or stiffness term is off by ~1e-2 h.
+    /// Also the value by hand at one state.
+    #[test]
+    fn tank_force_is_the_modes_momentum_balance() {
+        let m = Mode::new(4.0, 0.05);
+        let st = ModeState {
+            x: 0.01,
+            v: 0.2,
+            ..Default::default()
+        };
+        // 2 zeta omega v + omega^2 x = 0.4 * 0.2 + 16 * 0.01.
+        assert!((m.tank_force(&st) - 0.24).abs() < 1e-15);
+        let base = BaseAcceleration {
+            t0: 0.0,
+            a: [0.3, -0.8, 1.1],
+        };
+        let h = 0.01;
+        let (mut mid, mut end) = (st, st);
+        Mode::new(4.0, 0.05).advance(&mut mid, 0.5 * h, &base);
+        Mode::new(4.0, 0.05).advance(&mut end, h, &base);
+        let simpson = h / 6.0 * (m.tank_force(&st) + 4.0 * m.tank_force(&mid) + m.tank_force(&end));
+        let balance = -(end.v - st.v) - base.integral(h);
+        assert!(
+            (simpson - balance).abs() < 1e-7 * h,
+            "{simpson} vs {balance}"
+        );
+    }
+
+    /// Guards `stored_energy`: its change over steps is the work input less the dissipation,
+    /// both of which `polynomial_input_and_energies` checks against quadrature; and by hand.
+    #[test]
+    fn stored_energy_balances_the_exchanged_energies() {
+        let mut m = Mode::new(4.0, 0.05);
+        let start = ModeState {
+            x: 0.01,
+            v: 0.2,
+            ..Default::default()
+        };
+        // (0.2^2 + 16 * 0.01^2) / 2
+        assert!((m.stored_energy(&start) - 0.0208).abs() < 1e-15);
+        let base = BaseAcceleration {
+            t0: 0.0,
+            a: [0.3, -0.8, 1.1],
+        };
+        let mut st = start;
+        for _ in 0..7 {
+            m.advance(&mut st, 0.1, &base);
+        }
+        let change = m.stored_energy(&st) - m.stored_energy(&start);
+        assert!(
+            (change - (st.work_in - st.dissipated)).abs() < 1e-15,
+            "{change} vs {}",
+            st.work_in - st.dissipated
+        );
+        assert!(change.abs() > 1e-3, "the test must move energy: {change}");
+    }
 }
