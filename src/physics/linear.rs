@@ -337,7 +337,7 @@ mod tests {
     /// Also the value by hand at one state.
     #[test]
     fn tank_force_is_the_modes_momentum_balance() {
-        let m = Mode::new(4.0, 0.05);
+        let m = ModalOscillator::new(4.0, 0.05);
         let st = ModeState {
             x: 0.01,
             v: 0.2,
@@ -351,8 +351,8 @@ mod tests {
         };
         let h = 0.01;
         let (mut mid, mut end) = (st, st);
-        Mode::new(4.0, 0.05).advance(&mut mid, 0.5 * h, &base);
-        Mode::new(4.0, 0.05).advance(&mut end, h, &base);
+        ModalOscillator::new(4.0, 0.05).advance(&mut mid, 0.5 * h, &base);
+        ModalOscillator::new(4.0, 0.05).advance(&mut end, h, &base);
         let simpson = h / 6.0 * (m.tank_force(&st) + 4.0 * m.tank_force(&mid) + m.tank_force(&end));
         let balance = -(end.v - st.v) - base.integral(h);
         assert!(
@@ -365,7 +365,7 @@ mod tests {
     /// both of which `polynomial_input_and_energies` checks against quadrature; and by hand.
     #[test]
     fn stored_energy_balances_the_exchanged_energies() {
-        let mut m = Mode::new(4.0, 0.05);
+        let mut m = ModalOscillator::new(4.0, 0.05);
         let start = ModeState {
             x: 0.01,
             v: 0.2,
