@@ -32,3 +32,35 @@ impl BaseAcceleration {
         h * (self.a[0] + h * (0.5 * self.a[1] + h * self.a[2] * (1.0 / 6.0)))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The polynomial about t0, for every kind of input: held, a ramp, a parabola, with the
+    /// step starting at t0 != 0; and its integral, against the closed forms.
+    #[test]
+    fn the_input_is_its_taylor_polynomial_about_the_steps_start() {
+        for (t0, a) in [
+            (0.0, [0.7, 0.0, 0.0]),
+            (0.0, [0.7, -3.0, 0.0]),
+            (2.5, [0.7, -3.0, 0.0]),
+            (2.5, [0.7, -3.0, 8.0]),
+            (2.5, [0.0, 0.0, 8.0]),
+        ] {
+            let base = BaseAcceleration { t0, a };
+            for s in [0.0, 0.1, 0.37, 1.0] {
+                let exact = a[0] + a[1] * s + 0.5 * a[2] * s * s;
+                let got = base.at(t0 + s);
+                assert!(
+                    (got - exact).abs() <= 1e-15 * (1.0 + exact.abs()),
+                    "{t0} {a:?} {s}"
+                );
+                let integral = a[0] * s + 0.5 * a[1] * s * s + a[2] * s * s * s / 6.0;
+                let got = base.integral(s);
+                assert!((got - integral).abs() <= 1e-15 * (1.0 + integral.abs()));
+            }
+        }
+        assert_eq!(BaseAcceleration::held(0.3).at(7.0), 0.3);
+    }
+}
