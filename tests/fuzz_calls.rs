@@ -17,7 +17,7 @@ use fmi_sys::fmi2::*;
 use proptest::prelude::*;
 use std::ffi::CString;
 use std::sync::atomic::{AtomicU64, Ordering};
-use tld_fmu::fmi::vars::{VARIABLES, vr};
+use tld_fmu::fmi::vars::{ModelKindItem, VARIABLES, vr};
 
 const SEQUENCES: u32 = 2000;
 
@@ -334,27 +334,30 @@ fn random_call_sequences_keep_the_invariants() {
     };
     let mut runner = proptest::test_runner::TestRunner::new(config);
     // A third of the sequences start initialised, a third in initialisation mode, so that the
-    // calls reach every state, not mostly the first.
-    let prefix = prop_oneof![
-        Just(vec![]),
-        Just(vec![
-            Call::Setup {
+    // calls reach every state, not mostly the first; each with a model drawn from every item of
+    // the model enumeration, so that every model gets the same fuzzing.
+    let models: Vec<i32> = ModelKindItem::ALL
+        .iter()
+        .map(|m| m.value() as i32)
+        .collect();
+    let prefix = (0..3usize, proptest::sample::select(models)).prop_map(|(depth, model)| {
+        let mut calls = vec![Call::SetInteger {
+            vrs: vec![vr::MODEL],
+            values: vec![model, 0, 0, 0],
+        }];
+        if depth >= 1 {
+            calls.push(Call::Setup {
                 tolerance: None,
                 start: 0.0,
-                stop: None
-            },
-            Call::Enter
-        ]),
-        Just(vec![
-            Call::Setup {
-                tolerance: None,
-                start: 0.0,
-                stop: None
-            },
-            Call::Enter,
-            Call::Exit
-        ])
-    ];
+                stop: None,
+            });
+            calls.push(Call::Enter);
+        }
+        if depth == 2 {
+            calls.push(Call::Exit);
+        }
+        calls
+    });
     let sequences = (prefix, proptest::collection::vec(call(), 1..40)).prop_map(|(mut p, rest)| {
         p.extend(rest);
         p
