@@ -40,12 +40,6 @@ impl NonlinearTld {
     pub fn stored_energy(&self, x: f64, v: f64) -> f64 {
         0.5 * v * v + self.stiffness.potential(x)
     }
-
-    /// Relative acceleration x'' at (x, v) under base acceleration `a_b`.
-    #[inline]
-    pub fn acceleration(&self, x: f64, v: f64, a_b: f64) -> f64 {
-        -a_b - self.tank_force(x, v)
-    }
 }
 
 impl NonlinearTld {
@@ -365,6 +359,43 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// The stiffness estimate the stiffness-switching solver reads is the largest |eigenvalue|
+    /// of the (x, v) block of the model's own Jacobian, here from the block's trace and
+    /// determinant: underdamped and overdamped, inside the walls and beyond them.
+    #[test]
+    fn stiffness_is_the_largest_eigenvalue_of_the_oscillator_block() {
+        for (c, x) in [
+            (0.1, 0.0),
+            (0.1, 0.05),
+            (0.3, 0.2),
+            (40.0, 0.0),
+            (40.0, 0.15),
+        ] {
+            let model = NonlinearTld {
+                stiffness: PowerLaw::new(5.6, 1.0, 3.0, 0.25),
+                c,
+                base: BaseAcceleration::held(0.4),
+            };
+            let y = [x, 0.3, 0.0, 0.0];
+            let mut jac = [[0.0; state::DIM]; state::DIM];
+            model.jacobian(0.0, &y, &mut jac);
+            let (a, b) = (jac[state::X][state::X], jac[state::X][state::V]);
+            let (cc, d) = (jac[state::V][state::X], jac[state::V][state::V]);
+            let (half_trace, det) = (0.5 * (a + d), a * d - b * cc);
+            let disc = half_trace * half_trace - det;
+            let largest = if disc < 0.0 {
+                det.sqrt()
+            } else {
+                (half_trace.abs() + disc.sqrt()).max((half_trace.abs() - disc.sqrt()).abs())
+            };
+            let got = model.stiffness(0.0, &y);
+            assert!(
+                (got - largest).abs() <= 1e-12 * largest,
+                "c {c} x {x}: {got} vs {largest}"
+            );
         }
     }
 }
