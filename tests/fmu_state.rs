@@ -46,14 +46,7 @@ fn serialized_state_restores_in_another_instance() {
     let t_saved = a.time;
     let uninterrupted = a.run_harmonic(180, 0.01);
     let mut b = Instance::new("state-target");
-    let (status, restored) = deserialize(&b, &bytes);
-    assert_eq!(status, OK, "{:?}", b.logs());
-    assert_eq!(
-        unsafe { b.lib.fmi2SetFMUstate(b.c, restored) },
-        OK,
-        "{:?}",
-        b.logs()
-    );
+    let restored = restore(&b, &bytes);
     b.time = t_saved;
     let continued = b.run_harmonic(180, 0.01);
     assert_eq!(uninterrupted.to_bits(), continued.to_bits());
@@ -163,14 +156,7 @@ fn shallow_water_state_round_trip() {
     let t_saved = a.time;
     let uninterrupted = a.run_harmonic(200, 0.01);
     let mut b = start("swe-target");
-    let (status, restored) = deserialize(&b, &bytes);
-    assert_eq!(status, OK, "{:?}", b.logs());
-    assert_eq!(
-        unsafe { b.lib.fmi2SetFMUstate(b.c, restored) },
-        OK,
-        "{:?}",
-        b.logs()
-    );
+    let restored = restore(&b, &bytes);
     b.time = t_saved;
     let continued = b.run_harmonic(200, 0.01);
     assert_eq!(continued.to_bits(), uninterrupted.to_bits());
@@ -209,14 +195,7 @@ fn slamming_state_round_trip() {
     let n_a = impacts(&a);
     assert!(n_a >= 1, "the scene must slam: {n_a} impacts");
     let mut b = start("s2-target");
-    let (status, restored) = deserialize(&b, &bytes);
-    assert_eq!(status, OK, "{:?}", b.logs());
-    assert_eq!(
-        unsafe { b.lib.fmi2SetFMUstate(b.c, restored) },
-        OK,
-        "{:?}",
-        b.logs()
-    );
+    let restored = restore(&b, &bytes);
     b.time = t_saved;
     assert_eq!(b.run_harmonic(300, 0.01).to_bits(), uninterrupted.to_bits());
     assert_eq!(impacts(&b), n_a);

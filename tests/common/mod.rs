@@ -230,6 +230,16 @@ pub fn deserialize(inst: &Instance, bytes: &[u8]) -> (u32, fmi_sys::fmi2::fmi2FM
     (status, s)
 }
 
+/// `bytes` deserialised and set into `inst` (both calls must succeed); the state, to be freed.
+pub fn restore(inst: &Instance, bytes: &[u8]) -> fmi_sys::fmi2::fmi2FMUstate {
+    let (status, restored) = deserialize(inst, bytes);
+    assert_eq!(status, OK, "{:?}", inst.logs());
+    // SAFETY: our instance and a state it just made.
+    let set = unsafe { inst.lib.fmi2SetFMUstate(inst.c, restored) };
+    assert_eq!(set, OK, "{:?}", inst.logs());
+    restored
+}
+
 /// An instance out of initialisation mode with the Tracked amplitude estimate (amplitude = 2),
 /// whose state holds more than x and v.
 pub fn tracked(name: &str) -> Instance {
