@@ -5,6 +5,7 @@ use super::check_runaway;
 use super::rates::{self, Oscillator};
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
 use crate::description::{limits, vr};
+use crate::physics::geometry::NaturalMode;
 use crate::physics::linear::{ModalOscillator, ModeState};
 
 /// Numbers saved after the modes' states: the integrator memory of the state format, unused.
@@ -44,7 +45,6 @@ impl LinearMode {
         let w2 = w * w;
         Oscillator {
             mass: self.mass,
-            x: s.x,
             v: s.v,
             c: 2.0 * self.mode.zeta * w,
             restoring: w2 * s.x,
@@ -88,9 +88,10 @@ impl Model for Linear {
             ));
         }
         let tanks = f64::from(common.tanks);
-        let modes: Vec<LinearMode> = (1..=modes)
-            .map(|k| {
-                let m = common.tank.mode(k);
+        let natural: Vec<NaturalMode> = (1..=modes).map(|k| common.tank.mode(k)).collect();
+        let modes: Vec<LinearMode> = (1..)
+            .zip(&natural)
+            .map(|(k, m)| {
                 // The initial condition belongs to the fundamental mode.
                 let (x, v) = if k == 1 {
                     (common.x0, common.v0)
@@ -108,9 +109,9 @@ impl Model for Linear {
                 }
             })
             .collect();
-        let sum = (1..=modes.len() as u32)
-            .map(|k| common.tank.mode(k).mass)
-            .sum::<f64>();
+        // The modal masses summed, then scaled to all tanks (as the calculated parameter
+        // mass.slosh has always been formed).
+        let sum = natural.iter().map(|m| m.mass).sum::<f64>();
         Ok(Linear {
             modes,
             sloshing_mass: sum * tanks,

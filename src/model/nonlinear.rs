@@ -415,7 +415,6 @@ impl Model for Nonlinear {
         let (x, v) = self.sloshing();
         let oscillator = Oscillator {
             mass: self.mass,
-            x,
             v,
             c: self.tld.c,
             restoring: self.tld.stiffness.force(x),

@@ -3,12 +3,11 @@
 
 use super::Output;
 
-/// One oscillator now: mass [kg], x, v, damping c [1/s], restoring force per unit mass f(x)
-/// and its slope f'(x).
+/// One oscillator now: mass [kg], v, damping c [1/s], restoring force per unit mass f(x) and
+/// its slope f'(x).
 #[derive(Clone, Copy, Debug)]
 pub struct Oscillator {
     pub mass: f64,
-    pub x: f64,
     pub v: f64,
     pub c: f64,
     pub restoring: f64,
