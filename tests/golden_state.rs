@@ -12,7 +12,6 @@
 mod common;
 
 use common::*;
-use fmi_sys::fmi2::fmi2FMUstate;
 use std::path::PathBuf;
 use tld_fmu::fmi::vars::{AmplitudeModeItem, ModelKindItem, vr};
 
@@ -67,36 +66,13 @@ fn run(inst: &mut Instance, from: usize, to: usize) -> Vec<(u64, u64)> {
         .collect()
 }
 
+/// The instance's state, serialised (the state itself freed).
 fn state_bytes(inst: &Instance) -> Vec<u8> {
-    let mut s: fmi2FMUstate = std::ptr::null_mut();
-    let mut n = 0usize;
-    // SAFETY: our instance; the state is freed below.
-    unsafe {
-        assert_eq!(inst.lib.fmi2GetFMUstate(inst.c, &mut s), OK);
-        assert_eq!(inst.lib.fmi2SerializedFMUstateSize(inst.c, s, &mut n), OK);
-        let mut bytes = vec![0u8; n];
-        let buffer = bytes.as_mut_ptr() as *mut _;
-        assert_eq!(inst.lib.fmi2SerializeFMUstate(inst.c, s, buffer, n), OK);
-        assert_eq!(inst.lib.fmi2FreeFMUstate(inst.c, &mut s), OK);
-        bytes
-    }
-}
-
-fn restore(inst: &Instance, bytes: &[u8]) {
-    let mut s: fmi2FMUstate = std::ptr::null_mut();
-    // SAFETY: our instance and a buffer of bytes.len() bytes.
-    unsafe {
-        let buffer = bytes.as_ptr() as *const _;
-        assert_eq!(
-            inst.lib
-                .fmi2DeSerializeFMUstate(inst.c, buffer, bytes.len(), &mut s),
-            OK,
-            "{:?}",
-            inst.logs()
-        );
-        assert_eq!(inst.lib.fmi2SetFMUstate(inst.c, s), OK, "{:?}", inst.logs());
-        assert_eq!(inst.lib.fmi2FreeFMUstate(inst.c, &mut s), OK);
-    }
+    let mut s = get_state(inst);
+    let bytes = serialize(inst, s);
+    // SAFETY: our instance and its state, freed once.
+    assert_eq!(unsafe { inst.lib.fmi2FreeFMUstate(inst.c, &mut s) }, OK);
+    bytes
 }
 
 fn golden(model: ModelKindItem) -> PathBuf {
@@ -131,7 +107,12 @@ fn committed_states_of_version_1_restore_and_continue_bit_for_bit() {
             committed.iter().zip(&bytes).position(|(a, b)| a != b)
         );
         let mut target = Instance::new(&format!("golden-target-{}", model.name()));
-        restore(&target, &committed);
+        let mut restored = restore(&target, &committed);
+        // SAFETY: our instance and its state, freed once.
+        assert_eq!(
+            unsafe { target.lib.fmi2FreeFMUstate(target.c, &mut restored) },
+            OK
+        );
         target.time = BEFORE as f64 * H;
         let continued = run(&mut target, BEFORE, BEFORE + AFTER);
         assert_eq!(continued, uninterrupted, "{}", model.name());

@@ -122,6 +122,19 @@ fn dam_breaks_converge_to_ritter_and_stoker() {
 
 /// Resonant forcing of the lab tank violent enough for bores and for the bed to run dry at the
 /// walls: returns the flow after each communication step of `h` and what each step did.
+/// a_b = A w^2 sin(w t) over a step from `t`, as its Taylor polynomial (input derivatives).
+fn harmonic(amplitude: f64, w: f64, t: f64) -> BaseAcceleration {
+    let (s, c) = (w * t).sin_cos();
+    BaseAcceleration {
+        t0: 0.0,
+        a: [
+            amplitude * w * w * s,
+            amplitude * w * w * w * c,
+            -amplitude * w.powi(4) * s,
+        ],
+    }
+}
+
 fn violent(cells: usize, steps: usize, h: f64, amplitude: f64) -> Vec<(Flow, Advanced, f64)> {
     let ch = lab(cells);
     let w = omega_1(&ch);
@@ -129,16 +142,7 @@ fn violent(cells: usize, steps: usize, h: f64, amplitude: f64) -> Vec<(Flow, Adv
     let mut out = vec![];
     for k in 0..steps {
         let t = k as f64 * h;
-        // a_b = A w^2 sin(w t) as its Taylor polynomial over the step (input derivatives).
-        let (s, c) = (w * t).sin_cos();
-        let base = BaseAcceleration {
-            t0: 0.0,
-            a: [
-                amplitude * w * w * s,
-                amplitude * w * w * w * c,
-                -amplitude * w.powi(4) * s,
-            ],
-        };
+        let base = harmonic(amplitude, w, t);
         let d = ch
             .advance(&mut f, h, &base, 2.0 * 0.005 * w, 1_000_000)
             .expect("step");
@@ -490,15 +494,7 @@ fn an_hour_of_violent_sloshing_conserves_mass() {
     let mut worst: f64 = 0.0;
     for k in 0..360_000 {
         let t = k as f64 * h;
-        let (s, c) = (w * t).sin_cos();
-        let base = BaseAcceleration {
-            t0: 0.0,
-            a: [
-                amplitude * w * w * s,
-                amplitude * w * w * w * c,
-                -amplitude * w.powi(4) * s,
-            ],
-        };
+        let base = harmonic(amplitude, w, t);
         ch.advance(&mut f, h, &base, 2.0 * 0.005 * w, 1_000_000)
             .expect("step");
         assert!(f.depth.iter().all(|&d| d >= 0.0));
