@@ -50,6 +50,9 @@ pub struct Response {
     pub ratio: f64,
     /// First-harmonic amplitude of slosh.x [m].
     pub x: f64,
+    /// Its phase lag behind the excitation of Eq 2.11's right-hand side, -a_b [rad]: 0 far
+    /// below resonance, pi/2 at it, towards pi above.
+    pub phase: f64,
     /// Largest abs(slosh.x) over the measured cycles [m].
     pub x_peak: f64,
     /// Energy dissipated per cycle [J].
@@ -76,6 +79,7 @@ pub struct Sweeper {
 /// What one cycle measured.
 struct Cycle {
     x: f64,
+    phase: f64,
     x_peak: f64,
     energy: f64,
 }
@@ -132,8 +136,10 @@ impl Sweeper {
             c += x * end.cos();
             peak = peak.max(x.abs());
         }
+        // x = X sin(w t - phase) gives s = X cos(phase) n/2, c = -X sin(phase) n/2.
         Ok(Cycle {
             x: 2.0 * s.hypot(c) / f64::from(n),
+            phase: (-c).atan2(s),
             x_peak: peak,
             energy: self.damper.output(Output::EnergyDissipated, &none) - e0,
         })
@@ -180,10 +186,11 @@ impl Sweeper {
         };
         let cycles = history.len() as u32;
         let m = self.settling.measure_cycles;
-        let (mut x, mut x_peak, mut energy) = (0.0, 0.0f64, 0.0);
+        let (mut x, mut x_peak, mut energy, mut phase) = (0.0, 0.0f64, 0.0, 0.0);
         for _ in 0..m {
             let cycle = self.cycle(w)?;
             x += cycle.x;
+            phase += cycle.phase;
             x_peak = x_peak.max(cycle.x_peak);
             energy += cycle.energy;
         }
@@ -191,6 +198,7 @@ impl Sweeper {
         Ok(Response {
             ratio,
             x,
+            phase: phase / f64::from(m),
             x_peak,
             energy_per_cycle: energy,
             zeta_eq: self.zeta_eq(energy, w, x),
@@ -207,12 +215,19 @@ impl Sweeper {
 }
 
 /// What slow sweeps up and down show of a damper's amplitude dependence at one excitation
-/// amplitude: the NSD model's kappa (the frequency of the largest response, where an up-sweep
-/// with a jump falls off its upper branch) and zeta (energy-equivalent, at that frequency).
+/// amplitude, as the NSD model's two numbers: kappa, the frequency over omega_f where the
+/// up-sweep's response is in quadrature with the excitation (the equivalent linear oscillator's
+/// resonance, where its stiffness is w^2; at the top of the upper branch where an up-sweep
+/// jumps, within one harmonic's accuracy), and zeta, the energy-equivalent damping there (both
+/// interpolated linearly in the phase between the two frequencies around pi/2). The frequency
+/// of the largest response is no such measure once the damping is large: above zeta = 0.71 a
+/// linear oscillator's relative displacement grows monotonically with frequency.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Characteristic {
     /// Base amplitude over tank length, A/a.
     pub lambda: f64,
+    /// (kappa, zeta), None if the up-sweep never passes quadrature.
+    pub quadrature: Option<(f64, f64)>,
     /// Up-sweep: the largest response, and the jump down (before, after) if there is one.
     pub peak: Response,
     pub jump_down: Option<(Response, Response)>,
@@ -236,8 +251,9 @@ pub struct Plan {
 pub const JUMP_FACTOR: f64 = 1.5;
 
 /// Sweep the damper `p` configures up and down at base amplitude `lambda` times its tank length.
-/// The up-sweep stops once the response has fallen below half its largest value for three
-/// frequencies (past the peak, on the lower branch); the down-sweep starts where it stopped.
+/// The up-sweep stops once the response has been below half its largest value (past the peak,
+/// on the lower branch) or lagged by more than 3 pi/4 (well past quadrature) for three
+/// frequencies; the down-sweep starts where it stopped.
 pub fn characterise(
     p: &dyn Parameters,
     lambda: f64,
@@ -259,7 +275,8 @@ pub fn characterise(
         let r = sweeper.respond(plan.from + plan.step * k as f64)?;
         up.push(r);
         let top = peak(&up).map_or(0.0, |p| p.x);
-        below = if r.x < 0.5 * top { below + 1 } else { 0 };
+        let past = r.x < 0.5 * top || r.phase > 0.75 * PI;
+        below = if past { below + 1 } else { 0 };
         if below == 3 {
             break;
         }
@@ -277,6 +294,7 @@ pub fn characterise(
     };
     Ok(Characteristic {
         lambda,
+        quadrature: quadrature(&up),
         peak,
         jump_down: jump(&up, true, JUMP_FACTOR),
         jump_up: jump(&down, false, JUMP_FACTOR),
@@ -310,6 +328,23 @@ pub fn jump(responses: &[Response], down: bool, factor: f64) -> Option<(Response
         .filter(|(change, _, _)| *change > factor)
         .max_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, before, after)| (before, after))
+}
+
+/// The ratio and the equivalent damping where the phase of a sweep first passes pi/2,
+/// interpolated linearly in the phase.
+pub fn quadrature(responses: &[Response]) -> Option<(f64, f64)> {
+    let half = 0.5 * PI;
+    responses.windows(2).find_map(|p| {
+        let (a, b) = (p[0], p[1]);
+        if (a.phase - half) * (b.phase - half) > 0.0 || a.phase == b.phase {
+            return None;
+        }
+        let t = (half - a.phase) / (b.phase - a.phase);
+        Some((
+            a.ratio + t * (b.ratio - a.ratio),
+            a.zeta_eq + t * (b.zeta_eq - a.zeta_eq),
+        ))
+    })
 }
 
 /// The response with the largest first-harmonic amplitude.

@@ -33,8 +33,9 @@ fn tank() -> Tank {
 }
 
 /// A linear oscillator's steady state is the closed form
-/// X = w^2 A / sqrt((w_f^2 - w^2)^2 + (2 zeta w_f w)^2), and the energy-equivalent damping of a
-/// harmonic response is its zeta: across resonance, from rest.
+/// X = w^2 A / sqrt((w_f^2 - w^2)^2 + (2 zeta w_f w)^2) with the phase lag
+/// atan2(2 zeta r, 1 - r^2), and the energy-equivalent damping of a harmonic response is its
+/// zeta: across resonance, from rest.
 #[test]
 fn linear_steady_state_and_damping_are_the_closed_form() {
     let zeta = 0.02;
@@ -50,6 +51,8 @@ fn linear_steady_state_and_damping_are_the_closed_form() {
         assert!((r.x / exact - 1.0).abs() < 2e-3, "{r:?} vs {exact}");
         assert!((r.x_peak / exact - 1.0).abs() < 2e-3, "{r:?} vs {exact}");
         assert!((r.zeta_eq / zeta - 1.0).abs() < 2e-3, "{r:?}");
+        let lag = (2.0 * zeta * r.ratio).atan2(1.0 - r.ratio * r.ratio);
+        assert!((r.phase - lag).abs() < 2e-3, "{r:?} vs {lag}");
     }
 }
 
@@ -93,6 +96,13 @@ fn nonlinear_sweeps_jump_where_harmonic_balance_folds() {
         "up: {before:?} {after:?} vs harmonic balance {kappa}"
     );
     assert_eq!(c.peak.ratio, before.ratio);
+    // Quadrature at the top of the upper branch: within the frequency step of the peak.
+    let (k, z) = c.quadrature.expect("quadrature");
+    assert!(
+        (k - kappa).abs() <= 0.011,
+        "{k} vs harmonic balance {kappa}"
+    );
+    assert!((z / zeta - 1.0).abs() < 0.01, "{z}");
     assert!(
         (c.peak.x / hb_peak.x - 1.0).abs() < 0.015,
         "{:?} vs {hb_peak:?}",
@@ -103,6 +113,12 @@ fn nonlinear_sweeps_jump_where_harmonic_balance_folds() {
     assert!((c.peak.zeta_eq / zeta - 1.0).abs() < 0.01, "{:?}", c.peak);
     // The up-sweep stopped on the lower branch, three frequencies below half the peak.
     assert!(c.up.len() < 30 && c.up.iter().rev().take(3).all(|r| r.x < 0.5 * c.peak.x));
+    assert!(
+        c.up.iter()
+            .rev()
+            .take(3)
+            .all(|r| r.phase > 0.75 * std::f64::consts::PI)
+    );
     assert_eq!(
         c.down.first().map(|r| r.ratio),
         c.up.last().map(|r| r.ratio)
@@ -120,6 +136,7 @@ fn jumps_and_peaks_are_found_in_the_direction_asked() {
     let at = |ratio: f64, x: f64| Response {
         ratio,
         x,
+        phase: ratio,
         x_peak: x,
         energy_per_cycle: 0.0,
         zeta_eq: 0.0,
@@ -134,6 +151,11 @@ fn jumps_and_peaks_are_found_in_the_direction_asked() {
     assert!(jump(&rs, true, 7.0).is_none());
     assert_eq!(peak(&rs).map(|r| r.ratio), Some(1.1));
     assert_eq!(ratios(1.0, 2.0, 3), vec![1.0, 1.5, 2.0]);
+    // phase = ratio here: pi/2 is passed between 1.5 and 1.6, at 1.5708.
+    let rs = [at(1.4, 1.0), at(1.5, 1.0), at(1.6, 1.0), at(1.7, 1.0)];
+    let (k, _) = quadrature(&rs).expect("crossed");
+    assert!((k - 0.5 * std::f64::consts::PI).abs() < 1e-12);
+    assert!(quadrature(&rs[..2]).is_none());
 }
 
 #[test]
