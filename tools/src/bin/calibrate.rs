@@ -356,7 +356,55 @@ fn write_sweeps(path: &str, found: &[Characteristic]) -> Result<(), String> {
 
 #[cfg(test)]
 mod tests {
-    use super::read_samples;
+    use super::{Args, Parser, read_samples, run, shallow_water};
+    use tld_fmu::physics::geometry::Tank;
+
+    /// The shallow-water source end to end on a coarse tank (12 cells, steps of 0.05 w_f): both
+    /// amplitudes reach quadrature, the larger one later (hardening), with more damping; the
+    /// sweeps' CSV has every point.
+    #[test]
+    fn the_shallow_water_source_measures_hardening() {
+        let csv = std::env::temp_dir().join(format!("tld-calibrate-{}.csv", std::process::id()));
+        let o = Args::try_parse_from([
+            "tld-calibrate",
+            "--source",
+            "shallow-water",
+            "--cells",
+            "12",
+            "--step",
+            "0.05",
+            "--lowest",
+            "0.9",
+            "--highest",
+            "1.6",
+        ])
+        .expect("arguments");
+        let tank = Tank {
+            length: 0.25,
+            breadth: 0.32,
+            depth: 0.021,
+            density: 1000.0,
+            g: 9.81,
+        };
+        let found = shallow_water(&o, &tank, &[0.003, 0.03]).expect("sweeps");
+        let (k0, z0) = found[0].quadrature.expect("quadrature");
+        let (k1, z1) = found[1].quadrature.expect("quadrature");
+        assert!(k1 > k0 && z1 > z0, "{k0} {z0} {k1} {z1}");
+        super::write_sweeps(csv.to_str().expect("path"), &found).expect("written");
+        let text = std::fs::read_to_string(&csv).expect("read");
+        let points: usize = found.iter().map(|c| c.up.len() + c.down.len()).sum();
+        assert_eq!(text.lines().count(), 1 + points);
+        let _ = std::fs::remove_file(&csv);
+    }
+
+    #[test]
+    fn the_data_source_needs_a_file() {
+        let o = Args::try_parse_from(["tld-calibrate", "--source", "data"]).expect("arguments");
+        assert!(run(&o).unwrap_err().contains("--data"));
+        let o = Args::try_parse_from(["tld-calibrate", "--from", "0.1", "--to", "0.01"])
+            .expect("arguments");
+        assert!(run(&o).unwrap_err().contains("--from"));
+    }
 
     #[test]
     fn a_header_names_the_columns_in_any_order_and_case() {
