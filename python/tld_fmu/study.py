@@ -82,22 +82,29 @@ def expand(study: dict, unzipdir, md) -> list[dict]:
         w_f, m_liquid, m_inactive = probe(unzipdir, md, params, tanks)
         for tuning, amp, r in itertools.product(sw["tuning"], sw["ground_amplitude"], np.linspace(f0, f1, int(nf))):
             w_s = w_f / tuning
-            runs.append({"tuning": tuning, "tanks": tanks, "mass_ratio": m_liquid / st["mass"],
+            runs.append({"index": len(runs), "tuning": tuning, "tanks": tanks, "mass_ratio": m_liquid / st["mass"],
                          "ground_amplitude": amp, "frequency_ratio": float(r), "omega_s": w_s,
                          # the inactive liquid moves with the structure: K tunes M + inactive
-                         "stiffness": (st["mass"] + m_inactive) * w_s ** 2})
+                         "stiffness": (st["mass"] + m_inactive) * w_s ** 2, "inactive": m_inactive})
     return runs
 
 
-def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool = False) -> dict:
-    """One co-simulation; returns the run's row plus where it ran and how many instances its
-    thread has created so far. fresh=True: a new instance instead of the pool (for checks)."""
-    unzipdir, md, pool = _fmu_on_worker(fmu_bytes, digest)
-    st, rn = study["structure"], study["run"]
+def _config(study: dict, run: dict) -> tuple[dict, float, float]:
+    """A run as tld_fmu.building's master takes it: (cfg, w, ground amplitude)."""
+    st = study["structure"]
     cfg = {"building": {"masses": [st["mass"]], "stiffnesses": [run["stiffness"]],
                         "rayleigh": [st["damping"], st["damping"]]},
            "dampers": [{"floor": 1, "tanks": run["tanks"], "params": study.get("damper", {}).get("params", {})}]}
-    w, a = run["frequency_ratio"] * run["omega_s"], run["ground_amplitude"]
+    return cfg, run["frequency_ratio"] * run["omega_s"], run["ground_amplitude"]
+
+
+def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool = False) -> dict:
+    """One co-simulation by the Python master; returns the run's row plus where it ran and how
+    many instances its thread has created so far. fresh=True: a new instance instead of the
+    pool (for checks)."""
+    unzipdir, md, pool = _fmu_on_worker(fmu_bytes, digest)
+    rn = study["run"]
+    cfg, w, a = _config(study, run)
     s = building.simulate(cfg, unzipdir, md, building.harmonic_ground(w, a), rn["step"], rn["duration"], pool=None if fresh else pool,
                           derivatives=bool(rn.get("derivatives", False)))
     tail = s["t"] > rn["duration"] - rn["tail"]
@@ -106,42 +113,163 @@ def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool =
                 worker=f"{os.getpid()}/{threading.get_ident()}", instances=len(pool.dampers), error="")
 
 
+def run_name(run: dict) -> str:
+    """A run as its error messages name it."""
+    return (f"run {run['index']} (tuning {run['tuning']:g}, {run['tanks']} tank(s), ground amplitude "
+            f"{run['ground_amplitude']:g} m, w/w_s {run['frequency_ratio']:g})")
+
+
+def _master_on_worker(fmu_bytes: bytes, digest: str, master_bytes: bytes, master_digest: str):
+    """This thread's compiled master (a tld-study process with the FMU loaded), started on first
+    use and again if it has died; the binary is written next to the unpacked FMU."""
+    unzipdir, md, _ = _fmu_on_worker(fmu_bytes, digest)
+    masters = getattr(_local, "masters", None)
+    if masters is None:
+        masters = _local.masters = {}
+    key = (digest, master_digest)
+    m = masters.get(key)
+    if m is None or not m.alive():
+        from .native import Master
+        exe = Path(unzipdir).parent / f"tld-study-{master_digest[:16]}"
+        if not exe.exists():
+            tmp = exe.with_suffix(".part")
+            tmp.write_bytes(master_bytes)
+            tmp.chmod(0o755)
+            tmp.replace(exe)
+        m = masters[key] = Master(exe, unzipdir, md)
+    return m, md
+
+
+def run_batch(fmu_bytes: bytes, digest: str, master_bytes: bytes, master_digest: str, study: dict,
+              runs: list[dict]) -> list[dict]:
+    """Runs by the compiled master, one request for the batch; a row per run (a failed run's
+    row carries its error)."""
+    from .contract import Contract
+    from .native import request
+    m, md = _master_on_worker(fmu_bytes, digest, master_bytes, master_digest)
+    rn = study["run"]
+    contract = Contract(md)
+    reqs = []
+    for r in runs:
+        cfg, w, a = _config(study, r)
+        reqs.append(request(run_name(r), cfg, contract, [r["inactive"]], w, a, rn["step"], rn["duration"],
+                            rn["tail"], bool(rn.get("derivatives", False))))
+    where = f"{os.getpid()}/{threading.get_ident()}"
+    rows = []
+    for r, got in zip(runs, m.run(reqs)):
+        if "error" in got:
+            rows.append(failed_row(r, RuntimeError(got["error"])))
+        else:
+            peak = got["peak"][0]
+            rows.append(_row(r, peak_displacement=peak, amplification=peak / r["ground_amplitude"],
+                             worker=where, instances=got["instances"], error=""))
+    return rows
+
+
+ENGINES = ("native", "python")
+
+
+def master_binary() -> Path:
+    """The compiled master: $TLD_STUDY_MASTER, else tools' tld-study built (release) by cargo."""
+    from .paths import cargo_executable
+    env = os.environ.get("TLD_STUDY_MASTER")
+    return Path(env) if env else cargo_executable("tld-study", release=True)
+
+
+class Executor:
+    """Runs lists of runs of one study with one engine, here (client None) or on a dask client:
+    the python engine a task per run (the Python master), the native engine a task per batch of
+    runs (the compiled master, one per worker thread). The FMU (and the master) travel to the
+    workers as data, once."""
+
+    def __init__(self, study: dict, fmu_path: Path, client=None, engine: str = "native"):
+        if engine not in ENGINES:
+            raise ValueError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
+        self.study, self.client, self.engine = study, client, engine
+        self.fmu_bytes = Path(fmu_path).read_bytes()
+        self.digest = hashlib.sha256(self.fmu_bytes).hexdigest()
+        self.unzipdir, self.md, _ = _fmu_on_worker(self.fmu_bytes, self.digest)
+        if engine == "native":
+            self.master_bytes = master_binary().read_bytes()
+            self.master_digest = hashlib.sha256(self.master_bytes).hexdigest()
+        self.data = self.master_data = None
+        if client is not None:
+            # fresh keys: no race with a released earlier scatter
+            self.data = client.scatter(self.fmu_bytes, broadcast=True, hash=False)
+            if engine == "native":
+                self.master_data = client.scatter(self.master_bytes, broadcast=True, hash=False)
+
+    def batch_size(self, n: int) -> int:
+        """Runs per task: about 8 tasks per worker thread (load balance at the end, progress),
+        at most 64 runs (the task overhead is then < 1 %)."""
+        threads = sum(self.client.nthreads().values()) if self.client is not None else 1
+        return max(1, min(64, math.ceil(n / (8 * threads))))
+
+    def run(self, runs: list[dict], bar=None) -> list[dict]:
+        """The runs' rows, in their order; a run that failed is a row with NaN results and the
+        reason (the others are not lost)."""
+        rows: list = [None] * len(runs)
+        if self.engine == "python":
+            chunks = [[i] for i in range(len(runs))]
+        else:
+            b = self.batch_size(len(runs))
+            chunks = [list(range(i, min(i + b, len(runs)))) for i in range(0, len(runs), b)]
+
+        def done(idx, result=None, error=None):
+            for j, i in enumerate(idx):
+                rows[i] = result[j] if error is None else failed_row(runs[i], error)
+            if bar is not None:
+                bar.update(len(idx))
+
+        if self.client is None:
+            for idx in chunks:
+                try:
+                    done(idx, self._call(self.fmu_bytes, self.master_bytes if self.engine == "native" else None,
+                                         [runs[i] for i in idx]))
+                except Exception as e:   # one failed run (or batch) must not lose the others
+                    done(idx, error=e)
+            return rows
+        from distributed import as_completed
+        if self.engine == "python":
+            futures = self.client.map(run_one, [self.data] * len(runs), [self.digest] * len(runs),
+                                      [self.study] * len(runs), runs, pure=False)
+        else:
+            futures = self.client.map(run_batch, [self.data] * len(chunks), [self.digest] * len(chunks),
+                                      [self.master_data] * len(chunks), [self.master_digest] * len(chunks),
+                                      [self.study] * len(chunks), [[runs[i] for i in idx] for idx in chunks],
+                                      pure=False)
+        index = {f.key: idx for f, idx in zip(futures, chunks)}
+        for f in as_completed(futures):
+            idx = index[f.key]
+            try:
+                got = f.result()
+                done(idx, [got] if self.engine == "python" else got)
+            except Exception as e:
+                done(idx, error=e)
+        return rows
+
+    def _call(self, fmu_bytes, master_bytes, runs):
+        if self.engine == "python":
+            return [run_one(fmu_bytes, self.digest, self.study, runs[0])]
+        return run_batch(fmu_bytes, self.digest, master_bytes, self.master_digest, self.study, runs)
+
+
 def _row(run: dict, **results) -> dict:
     """A table row: the run's parameters and its results."""
     return {**{k: run[k] for k in COLUMNS if k in run}, **results}
 
 
-def run_study(study: dict, fmu_path: Path, client=None, progress=True) -> tuple[list[dict], float]:
-    """All runs of a study, on a dask client (None: here, serially, on one pool). Returns the
-    rows in study order and the wall time of the runs [s]."""
-    fmu_bytes = Path(fmu_path).read_bytes()
-    digest = hashlib.sha256(fmu_bytes).hexdigest()
-    unzipdir, md, _ = _fmu_on_worker(fmu_bytes, digest)
-    runs = expand(study, unzipdir, md)
+def run_study(study: dict, fmu_path: Path, client=None, progress=True, engine: str = "native",
+              executor: Executor | None = None) -> tuple[list[dict], float]:
+    """All runs of a study, on a dask client (None: here, serially), by the compiled master
+    (engine "native") or the Python one ("python"). Returns the rows in study order and the
+    wall time of the runs [s]."""
+    ex = executor or Executor(study, fmu_path, client, engine)
+    runs = expand(study, ex.unzipdir, ex.md)
     from tqdm import tqdm
-    bar = tqdm(total=len(runs), desc="runs", disable=not progress)
+    bar = tqdm(total=len(runs), desc=f"runs ({ex.engine} master)", disable=not progress)
     t0 = time.perf_counter()
-    rows = [None] * len(runs)
-    if client is None:
-        for i, r in enumerate(runs):
-            try:
-                rows[i] = run_one(fmu_bytes, digest, study, r)
-            except Exception as e:   # one failed run must not lose the others
-                rows[i] = failed_row(r, e)
-            bar.update()
-    else:
-        from distributed import as_completed
-        data = client.scatter(fmu_bytes, broadcast=True, hash=False)   # a fresh key: no race with a released earlier scatter
-        futures = client.map(run_one, [data] * len(runs), [digest] * len(runs), [study] * len(runs), runs,
-                             pure=False)
-        index = {f.key: i for i, f in enumerate(futures)}
-        for f in as_completed(futures):
-            i = index[f.key]
-            try:
-                rows[i] = f.result()
-            except Exception as e:
-                rows[i] = failed_row(runs[i], e)
-            bar.update()
+    rows = ex.run(runs, bar)
     bar.close()
     return rows, time.perf_counter() - t0
 
@@ -205,46 +333,31 @@ def _case(r: dict) -> tuple:
 
 
 def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xtol: float = 2e-3,
-                 progress=True) -> tuple[list[dict], list[dict]]:
+                 progress=True, engine: str = "native", executor: Executor | None = None
+                 ) -> tuple[list[dict], list[dict]]:
     """The peak over frequency of every case of a study (tuning x tanks x amplitude), refined from
     the grid runs `rows` (run_study's) by golden-section search to xtol in w / w_s; the searches of
     all cases advance in lockstep, one round of runs at a time (dask tasks on a client, else
-    serially). Returns (peaks: a row per case, the refinement runs' rows). A case whose grid
-    has a failed run is not refined (its peak row says so)."""
-    fmu_bytes = Path(fmu_path).read_bytes()
-    digest = hashlib.sha256(fmu_bytes).hexdigest()
-    unzipdir, md, _ = _fmu_on_worker(fmu_bytes, digest)
-    runs = expand(study, unzipdir, md)
+    serially). Returns (peaks: a row per case, the refinement runs' rows, numbered on from the
+    grid's). A case whose grid has a failed run is not refined (its peak row says so)."""
+    ex = executor or Executor(study, fmu_path, client, engine)
+    runs = expand(study, ex.unzipdir, ex.md)
     cases: dict[tuple, list[int]] = {}
     for i, r in enumerate(runs):
         cases.setdefault(_case(r), []).append(i)
     curves = {c: ([runs[i]["frequency_ratio"] for i in idx], [rows[i]["amplification"] for i in idx])
               for c, idx in cases.items() if not any(math.isnan(rows[i]["amplification"]) for i in idx)}
-    data = None
-    if client is not None:
-        data = client.scatter(fmu_bytes, broadcast=True, hash=False)
     from tqdm import tqdm
-    bar = tqdm(desc="peak refinement runs", disable=not progress)
+    bar = tqdm(desc=f"peak refinement runs ({ex.engine} master)", disable=not progress)
     extra: list[dict] = []
 
     def evaluate(batch):
-        todo = [{**runs[cases[c][0]], "frequency_ratio": float(x)} for c, x in batch]
-        if client is None:
-            got = []
-            for r in todo:
-                try:
-                    got.append(run_one(fmu_bytes, digest, study, r))
-                except Exception as e:
-                    got.append(failed_row(r, e))
-        else:
-            futures = client.map(run_one, [data] * len(todo), [digest] * len(todo), [study] * len(todo), todo,
-                                 pure=False)
-            got = [f.result() if f.status == "finished" else failed_row(r, f.exception())
-                   for f, r in zip(_wait(futures), todo)]
+        todo = [{**runs[cases[c][0]], "frequency_ratio": float(x), "index": len(runs) + len(extra) + j}
+                for j, (c, x) in enumerate(batch)]
+        got = ex.run(todo, bar)
         for g in got:
             g["refinement"] = 1
         extra.extend(got)
-        bar.update(len(batch))
         return [g["amplification"] for g in got]
 
     # every grid maximum within half of the largest: a tuned damper's two peaks, either of which
@@ -266,12 +379,6 @@ def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xto
                     "refinement_runs": sum(len(q.points) for q in found[c]),
                     "note": "" if p.bounded else "peak at the edge of the frequency range: widen it"})
     return out, extra
-
-
-def _wait(futures):
-    from distributed import wait
-    wait(futures)
-    return futures
 
 
 PEAK_COLUMNS = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "peak_frequency_ratio", "peak_amplification",
@@ -342,6 +449,9 @@ def main(argv=None):
                     help="directory for STUDY.csv, STUDY-peaks.csv and STUDY.png (default out/sweep)")
     ap.add_argument("--xtol", type=float, default=2e-3,
                     help="tolerance of the refined peak frequencies, in w / w_s (default 0.002)")
+    ap.add_argument("--engine", choices=ENGINES, default="native",
+                    help="native (default): the compiled master, tools' tld-study, batches of runs per task; "
+                         "python: tld_fmu.building's master, a task per run")
     args = ap.parse_args(argv)
     study = tomllib.loads(Path(args.study).read_text())
     out = Path(args.out)
@@ -350,9 +460,10 @@ def main(argv=None):
     if not args.serial:
         client, cluster = connect(args.scheduler, args.workers)
     try:
-        rows, wall = run_study(study, Path(args.fmu), client)
+        ex = Executor(study, Path(args.fmu), client, args.engine)
+        rows, wall = run_study(study, Path(args.fmu), executor=ex)
         t0 = time.perf_counter()
-        peaks, extra = refine_study(study, Path(args.fmu), rows, client, args.xtol)
+        peaks, extra = refine_study(study, Path(args.fmu), rows, xtol=args.xtol, executor=ex)
         wall_refine = time.perf_counter() - t0
     finally:
         if client is not None:
@@ -369,7 +480,7 @@ def main(argv=None):
     if failed:
         print(f"{len(failed)} of {len(rows)} runs failed (NaN in the table, reason in its 'error' column); "
               f"first: {failed[0]['error']}")
-    print(f"{len(rows)} runs in {wall:.1f} s ({len(rows) / wall:.2f} runs/s, {where}); "
+    print(f"{len(rows)} runs in {wall:.1f} s ({len(rows) / wall:.2f} runs/s, {where}, {args.engine} master); "
           f"{len({r['worker'] for r in rows})} worker threads, at most {max(r['instances'] for r in rows)} "
           f"FMU instance(s) each; then {len(extra)} refinement runs in {wall_refine:.1f} s "
           f"(peaks to +-{args.xtol:g} w_s)")
