@@ -72,21 +72,144 @@ def probe(unzipdir, md, params, tanks):
     return values
 
 
+def axes(study: dict) -> list[str]:
+    """The FMU parameters the study varies ([study] params = {NAME = [values]}), in order."""
+    return list(study["study"].get("params", {}))
+
+
+def variants(study: dict) -> list[dict]:
+    """Every combination of the varied FMU parameters' values ([{}] if none is varied)."""
+    p = study["study"].get("params", {})
+    return [dict(zip(p, combo)) for combo in itertools.product(*p.values())]
+
+
 def expand(study: dict, unzipdir, md) -> list[dict]:
     """The runs of a study: one dict per combination, with the structure that realises it."""
     st, sw = study["structure"], study["study"]
     params = study.get("damper", {}).get("params", {})
     f0, f1, nf = sw["frequency"]
     runs = []
-    for tanks in sw["tanks"]:
-        w_f, m_liquid, m_inactive = probe(unzipdir, md, params, tanks)
-        for tuning, amp, r in itertools.product(sw["tuning"], sw["ground_amplitude"], np.linspace(f0, f1, int(nf))):
-            w_s = w_f / tuning
-            runs.append({"index": len(runs), "tuning": tuning, "tanks": tanks, "mass_ratio": m_liquid / st["mass"],
-                         "ground_amplitude": amp, "frequency_ratio": float(r), "omega_s": w_s,
-                         # the inactive liquid moves with the structure: K tunes M + inactive
-                         "stiffness": (st["mass"] + m_inactive) * w_s ** 2, "inactive": m_inactive})
+    for variant in variants(study):
+        for tanks in sw["tanks"]:
+            w_f, m_liquid, m_inactive = probe(unzipdir, md, {**params, **variant}, tanks)
+            for tuning, amp, r in itertools.product(sw["tuning"], sw["ground_amplitude"], np.linspace(f0, f1, int(nf))):
+                w_s = w_f / tuning
+                runs.append({"index": len(runs), **variant, "params": variant, "tuning": tuning, "tanks": tanks,
+                             "mass_ratio": m_liquid / st["mass"],
+                             "ground_amplitude": amp, "frequency_ratio": float(r), "omega_s": w_s,
+                             # the inactive liquid moves with the structure: K tunes M + inactive
+                             "stiffness": (st["mass"] + m_inactive) * w_s ** 2, "inactive": m_inactive})
     return runs
+
+
+class StudyError(ValueError):
+    """A study file that cannot be run as written."""
+
+
+# the keys a study file may have, and what each must be
+_SCHEMA = {
+    "structure": {"mass": "modal mass [kg], > 0", "damping": "damping ratio, 0 <= zeta < 1"},
+    "damper": {"params": "FMU parameters {name = value}"},
+    "study": {"tuning": "omega_f / omega_s, a list of numbers > 0",
+              "tanks": "a list of whole numbers >= 1",
+              "ground_amplitude": "a list of amplitudes [m] > 0",
+              "frequency": "[from, to, points] in omega / omega_s, 0 < from <= to, points >= 1",
+              "params": "FMU parameters varied: {name = [values]}"},
+    "run": {"duration": "s per run, > 0", "tail": "s, 0 < tail <= duration",
+            "step": "communication step [s], 0 < step <= duration",
+            "derivatives": "true or false"},
+}
+_REQUIRED = {"structure": ("mass", "damping"), "study": ("tuning", "tanks", "ground_amplitude", "frequency"),
+             "run": ("duration", "tail", "step")}
+
+
+def check_study(study: dict, contract) -> None:
+    """Raise StudyError listing everything wrong with a study (unknown keys, missing ones,
+    impossible values, FMU parameters the modelDescription does not have)."""
+    errs = []
+
+    def num(x, ok=lambda v: True) -> bool:
+        return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and ok(x)
+
+    for sec, table in study.items():
+        if sec not in _SCHEMA:
+            errs.append(f"unknown section [{sec}] (known: {', '.join(_SCHEMA)})")
+        elif not isinstance(table, dict):
+            errs.append(f"[{sec}] must be a table")
+        else:
+            errs += [f"unknown key {k!r} in [{sec}] (known: {', '.join(_SCHEMA[sec])})"
+                     for k in table if k not in _SCHEMA[sec]]
+    for sec, keys in _REQUIRED.items():
+        errs += [f"[{sec}] {k} is missing: {_SCHEMA[sec][k]}" for k in keys
+                 if k not in study.get(sec, {}) if isinstance(study.get(sec, {}), dict)]
+    if errs:
+        raise StudyError("; ".join(errs))
+    st, sw, rn = study["structure"], study["study"], study["run"]
+
+    def want(ok, sec, key):
+        if not ok:
+            errs.append(f"[{sec}] {key} = {study[sec][key]!r}: need {_SCHEMA[sec][key]}")
+
+    want(num(st["mass"], lambda v: v > 0), "structure", "mass")
+    want(num(st["damping"], lambda v: 0 <= v < 1), "structure", "damping")
+    for key, ok in (("tuning", lambda v: num(v, lambda x: x > 0)),
+                    ("tanks", lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 1),
+                    ("ground_amplitude", lambda v: num(v, lambda x: x > 0))):
+        want(isinstance(sw[key], list) and sw[key] and all(ok(v) for v in sw[key]), "study", key)
+    f = sw["frequency"]
+    want(isinstance(f, list) and len(f) == 3 and num(f[0], lambda v: v > 0) and num(f[1], lambda v: v >= f[0])
+         and isinstance(f[2], int) and f[2] >= 1, "study", "frequency")
+    want(num(rn["duration"], lambda v: v > 0), "run", "duration")
+    if not errs:
+        want(num(rn["tail"], lambda v: 0 < v <= rn["duration"]), "run", "tail")
+        want(num(rn["step"], lambda v: 0 < v <= rn["duration"]), "run", "step")
+    want(isinstance(rn.get("derivatives", False), bool), "run", "derivatives") if "derivatives" in rn else None
+
+    def param(name, value, where):
+        try:
+            v = contract.variable(name)
+            if v.causality != "parameter":
+                errs.append(f"{where}: {name} is no parameter (causality {v.causality})")
+                return
+            contract.typed({name: value})
+        except (KeyError, TypeError, ValueError) as e:
+            errs.append(f"{where}: {e.args[0] if e.args else e}")
+
+    fixed = study.get("damper", {}).get("params", {})
+    if not isinstance(fixed, dict):
+        errs.append("[damper] params must be a table {name = value}")
+        fixed = {}
+    for name, value in fixed.items():
+        param(name, value, "[damper] params")
+    varied = sw.get("params", {})
+    if not isinstance(varied, dict):
+        errs.append("[study] params must be a table {name = [values]}")
+        varied = {}
+    for name, values in varied.items():
+        if name in COLUMNS or name == "tanks":
+            errs.append(f"[study] params: {name} is a column of the study; vary it with its own key")
+        elif not isinstance(values, list) or not values:
+            errs.append(f"[study] params.{name} = {values!r}: need a non-empty list of values")
+        else:
+            for value in values:
+                param(name, value, f"[study] params.{name}")
+    if errs:
+        raise StudyError("; ".join(errs))
+
+
+def load_study(path: Path, contract) -> dict:
+    """A study file, read and checked (StudyError names what is wrong)."""
+    try:
+        study = tomllib.loads(Path(path).read_text())
+    except tomllib.TOMLDecodeError as e:
+        raise StudyError(f"{path}: not valid TOML: {e}") from None
+    except OSError as e:
+        raise StudyError(f"{path}: {e.strerror}") from None
+    try:
+        check_study(study, contract)
+    except StudyError as e:
+        raise StudyError(f"{path}: {e}") from None
+    return study
 
 
 def _config(study: dict, run: dict) -> tuple[dict, float, float]:
@@ -94,7 +217,8 @@ def _config(study: dict, run: dict) -> tuple[dict, float, float]:
     st = study["structure"]
     cfg = {"building": {"masses": [st["mass"]], "stiffnesses": [run["stiffness"]],
                         "rayleigh": [st["damping"], st["damping"]]},
-           "dampers": [{"floor": 1, "tanks": run["tanks"], "params": study.get("damper", {}).get("params", {})}]}
+           "dampers": [{"floor": 1, "tanks": run["tanks"],
+                        "params": {**study.get("damper", {}).get("params", {}), **run.get("params", {})}}]}
     return cfg, run["frequency_ratio"] * run["omega_s"], run["ground_amplitude"]
 
 
@@ -256,7 +380,7 @@ class Executor:
 
 def _row(run: dict, **results) -> dict:
     """A table row: the run's parameters and its results."""
-    return {**{k: run[k] for k in COLUMNS if k in run}, **results}
+    return {**run.get("params", {}), **{k: run[k] for k in COLUMNS if k in run}, **results}
 
 
 def run_study(study: dict, fmu_path: Path, client=None, progress=True, engine: str = "native",
@@ -317,8 +441,9 @@ def _package_zip(directory: Path) -> str:
     return str(path)
 
 
-def write_table(rows: list[dict], path: Path):
-    cols = COLUMNS + ["worker", "instances", "error"]
+def write_table(rows: list[dict], path: Path, axes: list[str] = ()):
+    """A row per run; axes: the varied FMU parameters' columns (first)."""
+    cols = list(axes) + COLUMNS + ["worker", "instances", "error"]
     if any("refinement" in r for r in rows):
         cols.append("refinement")
         rows = [{"refinement": 0, **r} for r in rows]
@@ -329,7 +454,8 @@ def write_table(rows: list[dict], path: Path):
 
 
 def _case(r: dict) -> tuple:
-    return (r["tuning"], r["tanks"], r["ground_amplitude"])
+    """The case of a run (what its peak over frequency belongs to)."""
+    return (tuple(r.get("params", {}).items()), r["tuning"], r["tanks"], r["ground_amplitude"])
 
 
 def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xtol: float = 2e-3,
@@ -367,7 +493,7 @@ def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xto
     out = []
     for c, idx in cases.items():
         first = rows[idx[0]]
-        base = {k: first[k] for k in ("tuning", "tanks", "mass_ratio", "ground_amplitude")}
+        base = {**runs[idx[0]]["params"], **{k: first[k] for k in ("tuning", "tanks", "mass_ratio", "ground_amplitude")}}
         if c not in found:
             out.append({**base, "peak_frequency_ratio": math.nan, "peak_amplification": math.nan, "xtol": xtol,
                         "grid_frequency_ratio": math.nan, "grid_amplification": math.nan, "bounded": False,
@@ -385,11 +511,13 @@ PEAK_COLUMNS = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "peak_frequ
                 "xtol", "grid_frequency_ratio", "grid_amplification", "bounded", "refinement_runs", "note"]
 
 
-def write_peaks(peaks: list[dict], path: Path):
+def write_peaks(peaks: list[dict], path: Path, axes: list[str] = ()):
+    """A row per case; axes: the varied FMU parameters' columns (first)."""
+    cols = list(axes) + PEAK_COLUMNS
     with open(path, "w") as fh:
-        fh.write(",".join(PEAK_COLUMNS) + "\n")
+        fh.write(",".join(cols) + "\n")
         for r in peaks:
-            fh.write(",".join(repr(r[c]) if isinstance(r[c], float) else str(r[c]) for c in PEAK_COLUMNS) + "\n")
+            fh.write(",".join(repr(r[c]) if isinstance(r[c], float) else str(r[c]) for c in cols) + "\n")
 
 
 def bare_peak_amplification(zeta: float) -> float:
@@ -398,35 +526,45 @@ def bare_peak_amplification(zeta: float) -> float:
     return 1.0 / (2.0 * zeta * math.sqrt(1.0 - zeta * zeta))
 
 
-def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: str = ""):
-    """Refined peak amplification over tuning x mass ratio, a panel per amplitude; the bare
-    structure's (closed form, damping ratio zeta) for reference."""
+def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: str = "", axes: list[str] = ()):
+    """Refined peak amplification over tuning x mass ratio, a panel per amplitude (columns) and
+    per combination of the varied FMU parameters (rows); the bare structure's (closed form,
+    damping ratio zeta) for reference."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     tunings = sorted({r["tuning"] for r in peaks})
-    ratios = sorted({r["mass_ratio"] for r in peaks})
     amps = sorted({r["ground_amplitude"] for r in peaks if not math.isnan(r["ground_amplitude"])})
-    fig, axes = plt.subplots(1, max(1, len(amps)), figsize=(4.8 * max(1, len(amps)), 4.4), squeeze=False)
+    combos = list(dict.fromkeys(tuple(r[a] for a in axes) for r in peaks))
+    nr, nc = max(1, len(combos)), max(1, len(amps))
+    fig, grid = plt.subplots(nr, nc, figsize=(4.8 * nc, 4.4 * nr), squeeze=False)
     bare = bare_peak_amplification(zeta) if zeta else None
-    for ax, amp in zip(axes[0], amps):
+    small = len(tunings) > 6
+    # one colour scale for all panels: they are compared with each other
+    vals = [r["peak_amplification"] for r in peaks if not math.isnan(r["peak_amplification"])]
+    vmin, vmax = (min(vals), max(vals)) if vals else (None, None)
+    for (row, combo), (col, amp) in itertools.product(enumerate(combos), enumerate(amps)):
+        ax = grid[row][col]
+        mine = [r for r in peaks if r["ground_amplitude"] == amp and tuple(r[a] for a in axes) == combo]
+        ratios = sorted({r["mass_ratio"] for r in mine})
         Z = np.full((len(ratios), len(tunings)), np.nan)
         edge = np.zeros_like(Z, dtype=bool)
-        for r in peaks:
-            if r["ground_amplitude"] == amp:
-                i, j = ratios.index(r["mass_ratio"]), tunings.index(r["tuning"])
-                Z[i, j], edge[i, j] = r["peak_amplification"], not r["bounded"]
-        im = ax.imshow(Z, origin="lower", aspect="auto", cmap="viridis")
-        ax.set_xticks(range(len(tunings)), [f"{t:.2f}" for t in tunings])
+        for r in mine:
+            i, j = ratios.index(r["mass_ratio"]), tunings.index(r["tuning"])
+            Z[i, j], edge[i, j] = r["peak_amplification"], not r["bounded"]
+        im = ax.imshow(Z, origin="lower", aspect="auto", cmap="viridis", vmin=vmin, vmax=vmax)
+        ax.set_xticks(range(len(tunings)), [f"{t:.2f}" for t in tunings], fontsize=7 if small else None,
+                      rotation=90 if small else 0)
         ax.set_yticks(range(len(ratios)), [f"{100 * m:.2g} %" for m in ratios])
         for i, j in itertools.product(range(len(ratios)), range(len(tunings))):
             text = f"{Z[i, j]:.0f}" + ("*" if edge[i, j] else "")
-            if bare:
+            if bare and not small:
                 text += f"\n{100 * (1 - Z[i, j] / bare):.0f} % less"
-            ax.text(j, i, text, ha="center", va="center", color="w", fontsize=7)
+            ax.text(j, i, text, ha="center", va="center", color="w", fontsize=6 if small else 7)
         ax.set_xlabel(r"tuning $\omega_f / \omega_s$")
         ax.set_ylabel("mass ratio")
-        ax.set_title(f"ground amplitude {amp * 1e3:g} mm", fontsize=10)
+        what = ", ".join(f"{a} {v}" for a, v in zip(axes, combo))
+        ax.set_title(f"{what}{', ' if what else ''}ground amplitude {amp * 1e3:g} mm", fontsize=10)
         fig.colorbar(im, ax=ax, label="peak |X| / ground amplitude")
     head = f"{title}: " if title else ""
     ref = (f"without dampers {bare:.0f} (closed form 1/(2 zeta sqrt(1 - zeta^2)), zeta = {100 * zeta:g} %)"
@@ -453,7 +591,11 @@ def main(argv=None):
                     help="native (default): the compiled master, tools' tld-study, batches of runs per task; "
                          "python: tld_fmu.building's master, a task per run")
     args = ap.parse_args(argv)
-    study = tomllib.loads(Path(args.study).read_text())
+    from .contract import Contract
+    try:
+        study = load_study(Path(args.study), Contract(args.fmu))
+    except StudyError as e:
+        raise SystemExit(f"scripts/sweep.py: {e}") from None
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     client = cluster = None
@@ -472,9 +614,9 @@ def main(argv=None):
             cluster.close()
     name = Path(args.study).stem
     table, peaks_file, png = out / f"{name}.csv", out / f"{name}-peaks.csv", out / f"{name}.png"
-    write_table(rows + extra, table)
-    write_peaks(peaks, peaks_file)
-    heat_maps(peaks, png, study["structure"].get("damping"), name)
+    write_table(rows + extra, table, axes(study))
+    write_peaks(peaks, peaks_file, axes(study))
+    heat_maps(peaks, png, study["structure"].get("damping"), name, axes(study))
     where = "serial" if args.serial else (args.scheduler or f"LocalCluster, {args.workers} workers")
     failed = [r for r in rows if r["error"]]
     if failed:
