@@ -553,7 +553,7 @@ def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: s
             i, j = ratios.index(r["mass_ratio"]), tunings.index(r["tuning"])
             Z[i, j], edge[i, j] = r["peak_amplification"], not r["bounded"]
         im = ax.imshow(Z, origin="lower", aspect="auto", cmap="viridis", vmin=vmin, vmax=vmax)
-        ax.set_xticks(range(len(tunings)), [f"{t:.2f}" for t in tunings], fontsize=7 if small else None,
+        ax.set_xticks(range(len(tunings)), [f"{t:.3g}" for t in tunings], fontsize=7 if small else None,
                       rotation=90 if small else 0)
         ax.set_yticks(range(len(ratios)), [f"{100 * m:.2g} %" for m in ratios])
         for i, j in itertools.product(range(len(ratios)), range(len(tunings))):

@@ -67,6 +67,13 @@ impl Harmonic {
         let s = (w * t).sin();
         (-w * w * a * s, w * a * (w * t).cos(), a * s)
     }
+
+    /// a_g alone (the same number as `at(t).0`, without the cosine).
+    #[inline]
+    fn accel(&self, t: f64) -> f64 {
+        let (w, a) = (self.w, self.amplitude);
+        -w * w * a * (w * t).sin()
+    }
 }
 
 /// What a run gives: max |X| of every floor over the tail (X relative to the ground).
@@ -228,8 +235,21 @@ pub fn simulate(lib: &Library, pool: &mut Pool, run: &Run) -> Result<Outcome, St
                 .map(|d| if held { d.force_mean } else { d.force }),
         );
         df.fill(0.0);
+        // the ground at the step's start, mid-step and end: each time once (the Python master
+        // evaluates some twice, to the same numbers)
+        let (ag0, vg0, xg0) = if derivatives {
+            ground.at(t)
+        } else {
+            (ground.accel(t), 0.0, 0.0)
+        };
+        let ag_half = ground.accel(t + h / 2.0);
+        let end = if derivatives {
+            (ground.accel(t + h), 0.0, 0.0)
+        } else {
+            ground.at(t + h)
+        };
         if derivatives && nd > 0 {
-            let (ag, vg, xg) = ground.at(t);
+            let (ag, vg, xg) = (ag0, vg0, xg0);
             plus_zero(&f, &mut fe);
             s.accel(&x, &v, &fe, ag, &mut a0);
             // the force rates depend on base.a: read them with this step's inputs set
@@ -265,26 +285,26 @@ pub fn simulate(lib: &Library, pool: &mut Pool, run: &Run) -> Result<Outcome, St
         }
 
         // RK4 over the step (k1x = V)
-        s.accel(&x, &v, &fs[0], ground.at(t).0, &mut k1v);
+        s.accel(&x, &v, &fs[0], ag0, &mut k1v);
         let half = h / 2.0;
         for i in 0..n {
             x2[i] = x[i] + half * v[i];
             v2[i] = v[i] + half * k1v[i];
         }
         k2x.copy_from_slice(&v2);
-        s.accel(&x2, &v2, &fs[1], ground.at(t + h / 2.0).0, &mut k2v);
+        s.accel(&x2, &v2, &fs[1], ag_half, &mut k2v);
         for i in 0..n {
             x2[i] = x[i] + half * k2x[i];
             v2[i] = v[i] + half * k2v[i];
         }
         k3x.copy_from_slice(&v2);
-        s.accel(&x2, &v2, &fs[1], ground.at(t + h / 2.0).0, &mut k3v);
+        s.accel(&x2, &v2, &fs[1], ag_half, &mut k3v);
         for i in 0..n {
             x2[i] = x[i] + h * k3x[i];
             v2[i] = v[i] + h * k3v[i];
         }
         k4x.copy_from_slice(&v2);
-        s.accel(&x2, &v2, &fs[2], ground.at(t + h).0, &mut k4v);
+        s.accel(&x2, &v2, &fs[2], end.0, &mut k4v);
         let sixth = h / 6.0;
         for i in 0..n {
             x[i] += sixth * (v[i] + 2.0 * k2x[i] + 2.0 * k3x[i] + k4x[i]);
@@ -292,7 +312,7 @@ pub fn simulate(lib: &Library, pool: &mut Pool, run: &Run) -> Result<Outcome, St
         }
 
         if !derivatives && nd > 0 {
-            let (ag, vg, xg) = ground.at(t + h);
+            let (ag, vg, xg) = end;
             plus_zero(&f, &mut fe);
             s.accel(&x, &v, &fe, ag, &mut a_rel);
             for (d, &i) in dampers.iter_mut().zip(&floors) {
