@@ -37,10 +37,11 @@ def _encode(x):
 
 
 def request(name: str, cfg: dict, contract: Contract, inactive: list[float], w: float, amplitude: float,
-            step: float, duration: float, tail: float, derivatives: bool) -> dict:
+            step: float, duration: float, tail: float, derivatives: bool, timing: bool = False) -> dict:
     """One run for the master: cfg as tld_fmu.building.simulate takes it (building, dampers),
     inactive the dampers' mass.inactive (the master checks the FMU reports the same), ground
-    motion x_g = amplitude sin(w t)."""
+    motion x_g = amplitude sin(w t). timing: the master measures its time inside fmi2DoStep
+    (do_step_seconds; the clock costs some 50 ns a step, so only for benchmarks)."""
     dampers = cfg.get("dampers", [])
     bld = building.structure(cfg, [(d["floor"] - 1, m) for d, m in zip(dampers, inactive)])
     return {"name": name, "minv": bld.minv.tolist(), "c": bld.C.tolist(), "k": bld.K.tolist(),
@@ -49,7 +50,8 @@ def request(name: str, cfg: dict, contract: Contract, inactive: list[float], w: 
                                     contract.typed({"tanks": d.get("tanks", 1), **d.get("params", {})})],
                          "inactive": m} for d, m in zip(dampers, inactive)],
             "ground": {"w": w, "amplitude": amplitude},
-            "step": step, "duration": duration, "tail": tail, "derivatives": bool(derivatives)}
+            "step": step, "duration": duration, "tail": tail, "derivatives": bool(derivatives),
+            "timing": bool(timing)}
 
 
 class MasterError(RuntimeError):

@@ -197,6 +197,22 @@ def check_study(study: dict, contract) -> None:
         raise StudyError("; ".join(errs))
 
 
+def dump_study(d: dict) -> str:
+    """A study dict as a TOML file (tables of scalars, lists and inline tables)."""
+    def value(v):
+        if isinstance(v, dict):
+            return "{ " + ", ".join(f'"{k}" = {value(x)}' for k, x in v.items()) + " }"
+        if isinstance(v, list):
+            return "[" + ", ".join(value(x) for x in v) + "]"
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, float) and not math.isfinite(v):
+            return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
+        return repr(v)
+    return "".join(f"[{name}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in table.items())
+                   for name, table in d.items())
+
+
 def load_study(path: Path, contract) -> dict:
     """A study file, read and checked (StudyError names what is wrong)."""
     try:

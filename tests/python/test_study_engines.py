@@ -125,11 +125,10 @@ def test_a_master_that_dies_fails_its_runs_with_the_reason(fmu_path, tmp_path, m
 ])
 def test_study_files_that_cannot_work_are_refused_by_name(fmu_path, tmp_path, change, says):
     import copy
-    from test_sweep import toml
     study = copy.deepcopy(STUDY)
     change(study)
     f = tmp_path / "bad.toml"
-    f.write_text(toml(study))
+    f.write_text(sweep.dump_study(study))
     with pytest.raises(SystemExit) as e:
         sweep.main([str(f), "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path / "out")])
     assert says in str(e.value) and str(f) in str(e.value), str(e.value)

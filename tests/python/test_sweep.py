@@ -115,16 +115,7 @@ def test_outputs_are_named_after_the_study_file(fmu_path, tmp_path):
                        "tall_building-peaks.csv", "tall_building.csv", "tall_building.png"]
 
 
-def toml(d: dict) -> str:
-    """A minimal TOML writer for the study dict (tables of scalars, lists and inline tables)."""
-    def value(v):
-        if isinstance(v, dict):
-            return "{ " + ", ".join(f'"{k}" = {value(x)}' for k, x in v.items()) + " }"
-        if isinstance(v, list):
-            return "[" + ", ".join(value(x) for x in v) + "]"
-        return repr(v)
-    return "".join(f"[{name}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in table.items())
-                   for name, table in d.items())
+toml = sweep.dump_study
 
 
 @pytest.mark.parametrize("where", ["serial", "dask"])
