@@ -26,8 +26,9 @@ use clap::Parser;
 ///     co-simulate each run on this process's FMU instances (reused through fmi2Reset). RUN:
 ///     {"name", "minv", "c", "k", "dampers": [{"floor", "params": [{"vr", "real"|"integer"|
 ///     "boolean"}], "inactive"}], "ground": {"w", "amplitude"}, "step", "duration", "tail",
-///     "derivatives"}. Answer {"results": [{"peak": [max |X| per floor over the tail],
-///     "steps", "instances"} or {"error": "NAME: why"}, ...]}: a failed run loses no other.
+///     "derivatives", optional "timing"}. Answer {"results": [{"peak": [max |X| per floor over
+///     the tail], "steps", "instances", "do_step_seconds" (the time inside fmi2DoStep, measured
+///     with "timing": true)} or {"error": "NAME: why"}, ...]}: a failed run loses no other.
 ///
 /// Non-finite numbers may be given as the strings "NaN", "Infinity", "-Infinity"; a NaN result
 /// is null. Ends at the end of its input.

@@ -36,6 +36,9 @@ pub struct Run {
     #[serde(deserialize_with = "crate::protocol::number")]
     pub tail: f64,
     pub derivatives: bool,
+    /// measure the time inside fmi2DoStep (Outcome::do_step_seconds)
+    #[serde(default)]
+    pub timing: bool,
 }
 
 #[derive(Clone, Debug, serde::Deserialize)]
@@ -81,6 +84,8 @@ impl Harmonic {
 pub struct Outcome {
     pub peak: Vec<f64>,
     pub steps: usize,
+    /// with Run::timing: the time all dampers spent inside fmi2DoStep [s] (else 0)
+    pub do_step_seconds: f64,
 }
 
 /// FMU instances kept across runs: the k-th damper of a run reuses the k-th instance.
@@ -185,6 +190,10 @@ pub fn simulate(lib: &Library, pool: &mut Pool, run: &Run) -> Result<Outcome, St
         }
     }
     let dampers = &mut pool.instances[..nd];
+    for d in dampers.iter_mut() {
+        d.timed = run.timing;
+        d.in_do_step = std::time::Duration::ZERO;
+    }
     let floors: Vec<usize> = run.dampers.iter().map(|d| d.floor).collect();
     let mut s = Structure {
         minv: &run.minv,
@@ -328,5 +337,10 @@ pub fn simulate(lib: &Library, pool: &mut Pool, run: &Run) -> Result<Outcome, St
             }
         }
     }
-    Ok(Outcome { peak, steps })
+    let do_step_seconds = dampers.iter().map(|d| d.in_do_step.as_secs_f64()).sum();
+    Ok(Outcome {
+        peak,
+        steps,
+        do_step_seconds,
+    })
 }

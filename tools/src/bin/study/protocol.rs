@@ -107,6 +107,7 @@ impl Server {
                             Ok(o) => json!({
                                 "peak": o.peak,
                                 "steps": o.steps,
+                                "do_step_seconds": o.do_step_seconds,
                                 "instances": self.pool.instances.len(),
                             }),
                             Err(e) => {
