@@ -1,26 +1,39 @@
 """Design studies with TLD.fmu on dask.distributed: every combination of tuning ratio x mass ratio
-(number of tanks) x ground amplitude x excitation frequency of a study file is one co-simulation
-of a one-mode structure with the dampers on it (tld_fmu.building's master), run as one dask
-task. Each worker keeps its FMU instances and reuses them through fmi2Reset. The command line
-(scripts/sweep.py runs `main`):
+(number of tanks) x ground amplitude x excitation frequency of a study file, and of the FMU
+parameters it varies ([study] params = {name = [values]}), is one co-simulation of a one-mode
+structure with the dampers on it. The command line (scripts/sweep.py runs `main`):
 
     .venv/bin/python scripts/sweep.py scripts/examples/study.toml            # LocalCluster, 2 workers
     .venv/bin/python scripts/sweep.py STUDY --workers 1
     .venv/bin/python scripts/sweep.py STUDY --scheduler tcp://host:8786      # an existing cluster
+    .venv/bin/python scripts/sweep.py STUDY --engine python                  # the Python master
 
-The FMU travels to the workers as data (scattered once); the workers of a LocalCluster import
-this package from the venv, those of an existing scheduler get it uploaded (a zip), so a remote
-cluster needs only numpy and fmpy installed.
+Engines: "native" (the default) is the compiled master, tools' tld-study (tld_fmu.native): it
+dlopens TLD.fmu and runs tld_fmu.building's coupling, operation for operation the same, at the
+FMU's speed; the runs go to dask in batches, and each worker thread keeps one master process
+(its FMU instances reused through fmi2Reset). "python" is tld_fmu.building's master, a dask task
+per run, each worker keeping its FMU instances. Both give the same numbers
+(tests/python/test_study_engines.py).
 
-The peak over frequency of each case (tuning x tanks x amplitude) is refined (tld_fmu.peaks):
-the frequency grid brackets the largest response and a golden-section search of further runs,
-all cases in lockstep as dask tasks, locates it to +-xtol in w / w_s (--xtol, default 0.002).
+The FMU (and the master) travel to the workers as data (scattered once); the workers of a
+LocalCluster import this package from the venv, those of an existing scheduler get it uploaded
+(a zip), so a remote cluster needs only numpy and fmpy installed.
+
+The peak over frequency of each case (varied parameters x tuning x tanks x amplitude) is refined
+(tld_fmu.peaks): the frequency grid brackets the largest response and a golden-section search of
+further runs, all cases in lockstep, locates it to +-xtol in w / w_s (--xtol, default 0.002).
+
+A study file is checked first (check_study: unknown keys, impossible values, parameters the
+modelDescription lacks); a run that fails is a row with NaN results and the reason, naming the
+run, and loses no other.
 
 Writes, named after the study file STUDY.toml, into --out (default out/sweep): STUDY.csv (a row
 per run, the refinement runs included and marked), STUDY-peaks.csv (a row per case: the refined
-peak, the grid's, and the tolerance) and STUDY.png (heat maps of the refined peak amplification,
+peak, the grid's, and the tolerance), STUDY.png (heat maps of the refined peak amplification,
 max over frequency of the steady structure displacement / ground displacement, over tuning x mass
-ratio, one panel per amplitude, with the bare structure's value for reference).
+ratio, a panel per amplitude and varied parameter, with the bare structure's value for reference)
+and STUDY-best.png (the design chart: the best tuning's peak amplification against the mass
+ratio, a line per amplitude and varied parameter).
 """
 from __future__ import annotations
 
@@ -592,6 +605,47 @@ def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: s
     plt.close(fig)
 
 
+def best_tuning(peaks: list[dict], path: Path, zeta: float | None = None, title: str = "", axes: list[str] = ()):
+    """The design chart: for each combination of the varied parameters (a line style) and each
+    amplitude (a colour), the lowest refined peak amplification over the tunings against the
+    mass ratio, labelled with the tuning that reaches it."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    amps = sorted({r["ground_amplitude"] for r in peaks if not math.isnan(r["ground_amplitude"])})
+    combos = list(dict.fromkeys(tuple(r[a] for a in axes) for r in peaks))
+    fig, ax = plt.subplots(figsize=(8, 5))
+    for (ci, combo), (ai, amp) in itertools.product(enumerate(combos), enumerate(amps)):
+        best = {}
+        for r in peaks:
+            if r["ground_amplitude"] == amp and tuple(r[a] for a in axes) == combo \
+                    and not math.isnan(r["peak_amplification"]):
+                m = r["mass_ratio"]
+                if m not in best or r["peak_amplification"] < best[m]["peak_amplification"]:
+                    best[m] = r
+        if not best:
+            continue
+        ms = sorted(best)
+        what = ", ".join(f"{a} {v}" for a, v in zip(axes, combo))
+        ax.plot([100 * m for m in ms], [best[m]["peak_amplification"] for m in ms], "o",
+                ls=["-", "--", ":", "-."][ci % 4], color=f"C{ai}",
+                label=f"{what}{', ' if what else ''}{amp * 1e3:g} mm")
+        for m in ms:
+            ax.annotate(f"{best[m]['tuning']:.3g}", (100 * m, best[m]["peak_amplification"]), fontsize=6,
+                        textcoords="offset points", xytext=(3, 3), color=f"C{ai}")
+    ax.set_xlabel("mass ratio [%]")
+    ax.set_ylabel("peak |X| / ground amplitude at the best tuning")
+    ax.set_yscale("log")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, ncol=max(1, len(combos)))
+    bare = f"; without dampers {bare_peak_amplification(zeta):.0f}" if zeta else ""
+    ax.set_title(f"{title + ': ' if title else ''}the best tuning of each mass ratio (numbers: omega_f / omega_s), "
+                 f"refined peaks{bare}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("study", nargs="?", default=str(REPO / "scripts" / "examples" / "study.toml"))
@@ -633,6 +687,8 @@ def main(argv=None):
     write_table(rows + extra, table, axes(study))
     write_peaks(peaks, peaks_file, axes(study))
     heat_maps(peaks, png, study["structure"].get("damping"), name, axes(study))
+    chart = out / f"{name}-best.png"
+    best_tuning(peaks, chart, study["structure"].get("damping"), name, axes(study))
     where = "serial" if args.serial else (args.scheduler or f"LocalCluster, {args.workers} workers")
     failed = [r for r in rows if r["error"]]
     if failed:
@@ -642,5 +698,5 @@ def main(argv=None):
           f"{len({r['worker'] for r in rows})} worker threads, at most {max(r['instances'] for r in rows)} "
           f"FMU instance(s) each; then {len(extra)} refinement runs in {wall_refine:.1f} s "
           f"(peaks to +-{args.xtol:g} w_s)")
-    print(f"wrote {table}, {peaks_file}, {png}")
+    print(f"wrote {table}, {peaks_file}, {png}, {chart}")
     return rows

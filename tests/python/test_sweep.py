@@ -111,8 +111,9 @@ def test_outputs_are_named_after_the_study_file(fmu_path, tmp_path):
         sweep.main([str(tmp_path / f"{name}.toml"), "--serial", "--fmu", str(fmu_path), "--out",
                     str(tmp_path / "out"), "--xtol", "0.02"])
     written = sorted(p.name for p in (tmp_path / "out").iterdir())
-    assert written == ["small_tank-peaks.csv", "small_tank.csv", "small_tank.png",
-                       "tall_building-peaks.csv", "tall_building.csv", "tall_building.png"]
+    assert written == ["small_tank-best.png", "small_tank-peaks.csv", "small_tank.csv", "small_tank.png",
+                       "tall_building-best.png", "tall_building-peaks.csv", "tall_building.csv",
+                       "tall_building.png"]
 
 
 toml = sweep.dump_study
