@@ -428,9 +428,14 @@ def run_study(study: dict, fmu_path: Path, client=None, progress=True, engine: s
 
 
 def failed_row(run: dict, error: Exception) -> dict:
-    """A run that raised: its parameters, NaN results and the reason."""
+    """A run that raised: its parameters, NaN results and the reason, which names the run
+    (whichever engine, and whether the run or its whole batch failed)."""
+    text, name = str(error), run_name(run) if "index" in run else ""
+    if name and text.startswith(name + ": "):
+        text = text[len(name) + 2:]
+    msg = f"{name + ': ' if name else ''}{type(error).__name__}: {text}"
     return _row(run, peak_displacement=math.nan, amplification=math.nan, worker="", instances=0,
-                error=f"{type(error).__name__}: {error}".replace(",", ";").replace("\n", " "))
+                error=msg.replace(",", ";").replace("\n", " "))
 
 
 def connect(scheduler: str | None, workers: int):

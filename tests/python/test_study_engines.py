@@ -34,6 +34,17 @@ def master_path():
     return sweep.master_binary()
 
 
+@pytest.mark.parametrize("engine", sweep.ENGINES)
+def test_a_refused_run_names_itself_whichever_engine(fmu_path, engine):
+    study = {**STUDY, "study": {**STUDY["study"], "params": {}, "tanks": [1], "tuning": [1.0],
+                                "ground_amplitude": [math.nan], "frequency": [1.0, 1.0, 1]}}
+    rows, _ = sweep.run_study(study, fmu_path, progress=False, engine=engine)
+    assert len(rows) == 1
+    e = rows[0]["error"]
+    assert e.startswith("run 0 (tuning 1; 1 tank(s); ground amplitude nan m; w/w_s 1): RuntimeError: "
+                        "the damper refused its inputs at t = 0"), e
+
+
 @pytest.mark.parametrize("derivatives", [False, True], ids=["held", "derivatives"])
 def test_the_engines_agree_in_every_column(fmu_path, master_path, derivatives):
     study = {**STUDY, "run": {**STUDY["run"], "derivatives": derivatives}}
@@ -109,6 +120,7 @@ def test_a_master_that_dies_fails_its_runs_with_the_reason(fmu_path, tmp_path, m
     rows, _ = sweep.run_study(study, fmu_path, progress=False)
     assert len(rows) == 6
     assert all("no FMU here" in r["error"] and math.isnan(r["peak_displacement"]) for r in rows), rows[0]
+    assert all(r["error"].startswith(f"run {i} (tuning 1;") for i, r in enumerate(rows)), rows[0]["error"]
 
 
 @pytest.mark.parametrize("change, says", [
