@@ -45,7 +45,6 @@ import os
 import tempfile
 import threading
 import time
-import tomllib
 import zipfile
 from pathlib import Path
 
@@ -54,8 +53,8 @@ import numpy as np
 from . import building
 from . import peaks as pk
 from .paths import FMU, REPO
-COLUMNS = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "frequency_ratio", "omega_s",
-           "peak_displacement", "amplification"]
+from .studyfile import COLUMNS, StudyError, check_study, dump_study, load_study  # noqa: F401 (this module's API)
+from .studyplots import bare_peak_amplification, best_tuning, heat_maps  # noqa: F401
 
 _local = threading.local()   # per worker thread: {digest: (unzipdir, md, pool)}
 
@@ -113,132 +112,6 @@ def expand(study: dict, unzipdir, md) -> list[dict]:
                              # the inactive liquid moves with the structure: K tunes M + inactive
                              "stiffness": (st["mass"] + m_inactive) * w_s ** 2, "inactive": m_inactive})
     return runs
-
-
-class StudyError(ValueError):
-    """A study file that cannot be run as written."""
-
-
-# the keys a study file may have, and what each must be
-_SCHEMA = {
-    "structure": {"mass": "modal mass [kg], > 0", "damping": "damping ratio, 0 <= zeta < 1"},
-    "damper": {"params": "FMU parameters {name = value}"},
-    "study": {"tuning": "omega_f / omega_s, a list of numbers > 0",
-              "tanks": "a list of whole numbers >= 1",
-              "ground_amplitude": "a list of amplitudes [m] > 0",
-              "frequency": "[from, to, points] in omega / omega_s, 0 < from <= to, points >= 1",
-              "params": "FMU parameters varied: {name = [values]}"},
-    "run": {"duration": "s per run, > 0", "tail": "s, 0 < tail <= duration",
-            "step": "communication step [s], 0 < step <= duration",
-            "derivatives": "true or false"},
-}
-_REQUIRED = {"structure": ("mass", "damping"), "study": ("tuning", "tanks", "ground_amplitude", "frequency"),
-             "run": ("duration", "tail", "step")}
-
-
-def check_study(study: dict, contract) -> None:
-    """Raise StudyError listing everything wrong with a study (unknown keys, missing ones,
-    impossible values, FMU parameters the modelDescription does not have)."""
-    errs = []
-
-    def num(x, ok=lambda v: True) -> bool:
-        return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and ok(x)
-
-    for sec, table in study.items():
-        if sec not in _SCHEMA:
-            errs.append(f"unknown section [{sec}] (known: {', '.join(_SCHEMA)})")
-        elif not isinstance(table, dict):
-            errs.append(f"[{sec}] must be a table")
-        else:
-            errs += [f"unknown key {k!r} in [{sec}] (known: {', '.join(_SCHEMA[sec])})"
-                     for k in table if k not in _SCHEMA[sec]]
-    for sec, keys in _REQUIRED.items():
-        errs += [f"[{sec}] {k} is missing: {_SCHEMA[sec][k]}" for k in keys
-                 if k not in study.get(sec, {}) if isinstance(study.get(sec, {}), dict)]
-    if errs:
-        raise StudyError("; ".join(errs))
-    st, sw, rn = study["structure"], study["study"], study["run"]
-
-    def want(ok, sec, key):
-        if not ok:
-            errs.append(f"[{sec}] {key} = {study[sec][key]!r}: need {_SCHEMA[sec][key]}")
-
-    want(num(st["mass"], lambda v: v > 0), "structure", "mass")
-    want(num(st["damping"], lambda v: 0 <= v < 1), "structure", "damping")
-    for key, ok in (("tuning", lambda v: num(v, lambda x: x > 0)),
-                    ("tanks", lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 1),
-                    ("ground_amplitude", lambda v: num(v, lambda x: x > 0))):
-        want(isinstance(sw[key], list) and sw[key] and all(ok(v) for v in sw[key]), "study", key)
-    f = sw["frequency"]
-    want(isinstance(f, list) and len(f) == 3 and num(f[0], lambda v: v > 0) and num(f[1], lambda v: v >= f[0])
-         and isinstance(f[2], int) and f[2] >= 1, "study", "frequency")
-    want(num(rn["duration"], lambda v: v > 0), "run", "duration")
-    if not errs:
-        want(num(rn["tail"], lambda v: 0 < v <= rn["duration"]), "run", "tail")
-        want(num(rn["step"], lambda v: 0 < v <= rn["duration"]), "run", "step")
-    want(isinstance(rn.get("derivatives", False), bool), "run", "derivatives") if "derivatives" in rn else None
-
-    def param(name, value, where):
-        try:
-            v = contract.variable(name)
-            if v.causality != "parameter":
-                errs.append(f"{where}: {name} is no parameter (causality {v.causality})")
-                return
-            contract.typed({name: value})
-        except (KeyError, TypeError, ValueError) as e:
-            errs.append(f"{where}: {e.args[0] if e.args else e}")
-
-    fixed = study.get("damper", {}).get("params", {})
-    if not isinstance(fixed, dict):
-        errs.append("[damper] params must be a table {name = value}")
-        fixed = {}
-    for name, value in fixed.items():
-        param(name, value, "[damper] params")
-    varied = sw.get("params", {})
-    if not isinstance(varied, dict):
-        errs.append("[study] params must be a table {name = [values]}")
-        varied = {}
-    for name, values in varied.items():
-        if name in COLUMNS or name == "tanks":
-            errs.append(f"[study] params: {name} is a column of the study; vary it with its own key")
-        elif not isinstance(values, list) or not values:
-            errs.append(f"[study] params.{name} = {values!r}: need a non-empty list of values")
-        else:
-            for value in values:
-                param(name, value, f"[study] params.{name}")
-    if errs:
-        raise StudyError("; ".join(errs))
-
-
-def dump_study(d: dict) -> str:
-    """A study dict as a TOML file (tables of scalars, lists and inline tables)."""
-    def value(v):
-        if isinstance(v, dict):
-            return "{ " + ", ".join(f'"{k}" = {value(x)}' for k, x in v.items()) + " }"
-        if isinstance(v, list):
-            return "[" + ", ".join(value(x) for x in v) + "]"
-        if isinstance(v, bool):
-            return "true" if v else "false"
-        if isinstance(v, float) and not math.isfinite(v):
-            return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
-        return repr(v)
-    return "".join(f"[{name}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in table.items())
-                   for name, table in d.items())
-
-
-def load_study(path: Path, contract) -> dict:
-    """A study file, read and checked (StudyError names what is wrong)."""
-    try:
-        study = tomllib.loads(Path(path).read_text())
-    except tomllib.TOMLDecodeError as e:
-        raise StudyError(f"{path}: not valid TOML: {e}") from None
-    except OSError as e:
-        raise StudyError(f"{path}: {e.strerror}") from None
-    try:
-        check_study(study, contract)
-    except StudyError as e:
-        raise StudyError(f"{path}: {e}") from None
-    return study
 
 
 def _config(study: dict, run: dict) -> tuple[dict, float, float]:
@@ -552,103 +425,6 @@ def write_peaks(peaks: list[dict], path: Path, axes: list[str] = ()):
         fh.write(",".join(cols) + "\n")
         for r in peaks:
             fh.write(",".join(repr(r[c]) if isinstance(r[c], float) else str(r[c]) for c in cols) + "\n")
-
-
-def bare_peak_amplification(zeta: float) -> float:
-    """The bare one-mode structure's largest steady |X| / A_g under x_g = A_g sin(w t), closed
-    form: max over r of r^2 / sqrt((1 - r^2)^2 + (2 zeta r)^2) = 1 / (2 zeta sqrt(1 - zeta^2))."""
-    return 1.0 / (2.0 * zeta * math.sqrt(1.0 - zeta * zeta))
-
-
-def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: str = "", axes: list[str] = ()):
-    """Refined peak amplification over tuning x mass ratio, a panel per amplitude (columns) and
-    per combination of the varied FMU parameters (rows); the bare structure's (closed form,
-    damping ratio zeta) for reference."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    tunings = sorted({r["tuning"] for r in peaks})
-    amps = sorted({r["ground_amplitude"] for r in peaks if not math.isnan(r["ground_amplitude"])})
-    combos = list(dict.fromkeys(tuple(r[a] for a in axes) for r in peaks))
-    nr, nc = max(1, len(combos)), max(1, len(amps))
-    fig, grid = plt.subplots(nr, nc, figsize=(4.8 * nc, 4.4 * nr), squeeze=False)
-    bare = bare_peak_amplification(zeta) if zeta else None
-    small = len(tunings) > 6
-    # one colour scale for all panels: they are compared with each other
-    vals = [r["peak_amplification"] for r in peaks if not math.isnan(r["peak_amplification"])]
-    vmin, vmax = (min(vals), max(vals)) if vals else (None, None)
-    for (row, combo), (col, amp) in itertools.product(enumerate(combos), enumerate(amps)):
-        ax = grid[row][col]
-        mine = [r for r in peaks if r["ground_amplitude"] == amp and tuple(r[a] for a in axes) == combo]
-        ratios = sorted({r["mass_ratio"] for r in mine})
-        Z = np.full((len(ratios), len(tunings)), np.nan)
-        edge = np.zeros_like(Z, dtype=bool)
-        for r in mine:
-            i, j = ratios.index(r["mass_ratio"]), tunings.index(r["tuning"])
-            Z[i, j], edge[i, j] = r["peak_amplification"], not r["bounded"]
-        im = ax.imshow(Z, origin="lower", aspect="auto", cmap="viridis", vmin=vmin, vmax=vmax)
-        ax.set_xticks(range(len(tunings)), [f"{t:.3g}" for t in tunings], fontsize=7 if small else None,
-                      rotation=90 if small else 0)
-        ax.set_yticks(range(len(ratios)), [f"{100 * m:.2g} %" for m in ratios])
-        for i, j in itertools.product(range(len(ratios)), range(len(tunings))):
-            text = f"{Z[i, j]:.0f}" + ("*" if edge[i, j] else "")
-            if bare and not small:
-                text += f"\n{100 * (1 - Z[i, j] / bare):.0f} % less"
-            ax.text(j, i, text, ha="center", va="center", color="w", fontsize=6 if small else 7)
-        ax.set_xlabel(r"tuning $\omega_f / \omega_s$")
-        ax.set_ylabel("mass ratio")
-        what = ", ".join(f"{a} {v}" for a, v in zip(axes, combo))
-        ax.set_title(f"{what}{', ' if what else ''}ground amplitude {amp * 1e3:g} mm", fontsize=10)
-        fig.colorbar(im, ax=ax, label="peak |X| / ground amplitude")
-    head = f"{title}: " if title else ""
-    ref = (f"without dampers {bare:.0f} (closed form 1/(2 zeta sqrt(1 - zeta^2)), zeta = {100 * zeta:g} %)"
-           if bare else "")
-    fig.suptitle(f"{head}peak amplification over frequency, refined; {ref}\n"
-                 "* = at the edge of the frequency range (the peak may lie outside)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def best_tuning(peaks: list[dict], path: Path, zeta: float | None = None, title: str = "", axes: list[str] = ()):
-    """The design chart: for each combination of the varied parameters (a line style) and each
-    amplitude (a colour), the lowest refined peak amplification over the tunings against the
-    mass ratio, labelled with the tuning that reaches it."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    amps = sorted({r["ground_amplitude"] for r in peaks if not math.isnan(r["ground_amplitude"])})
-    combos = list(dict.fromkeys(tuple(r[a] for a in axes) for r in peaks))
-    fig, ax = plt.subplots(figsize=(8, 5))
-    for (ci, combo), (ai, amp) in itertools.product(enumerate(combos), enumerate(amps)):
-        best = {}
-        for r in peaks:
-            if r["ground_amplitude"] == amp and tuple(r[a] for a in axes) == combo \
-                    and not math.isnan(r["peak_amplification"]):
-                m = r["mass_ratio"]
-                if m not in best or r["peak_amplification"] < best[m]["peak_amplification"]:
-                    best[m] = r
-        if not best:
-            continue
-        ms = sorted(best)
-        what = ", ".join(f"{a} {v}" for a, v in zip(axes, combo))
-        ax.plot([100 * m for m in ms], [best[m]["peak_amplification"] for m in ms], "o",
-                ls=["-", "--", ":", "-."][ci % 4], color=f"C{ai}",
-                label=f"{what}{', ' if what else ''}{amp * 1e3:g} mm")
-        for m in ms:
-            ax.annotate(f"{best[m]['tuning']:.3g}", (100 * m, best[m]["peak_amplification"]), fontsize=6,
-                        textcoords="offset points", xytext=(3, 3), color=f"C{ai}")
-    ax.set_xlabel("mass ratio [%]")
-    ax.set_ylabel("peak |X| / ground amplitude at the best tuning")
-    ax.set_yscale("log")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, ncol=max(1, len(combos)))
-    bare = f"; without dampers {bare_peak_amplification(zeta):.0f}" if zeta else ""
-    ax.set_title(f"{title + ': ' if title else ''}the best tuning of each mass ratio (numbers: omega_f / omega_s), "
-                 f"refined peaks{bare}", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
 
 
 def main(argv=None):

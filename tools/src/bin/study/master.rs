@@ -225,6 +225,7 @@ pub fn simulate(lib: &Library, pool: &mut Pool, run: &Run) -> Result<Outcome, St
     let (mut k2x, mut k3x, mut k4x) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut a_rel = vec![0.0; n];
     let mut fe = vec![0.0; n];
+    let mut rates = Vec::with_capacity(nd);
 
     // per-damper values summed onto the dampers' floors
     let on_floors = |out: &mut [f64], values: &mut dyn Iterator<Item = f64>| {
@@ -265,11 +266,11 @@ pub fn simulate(lib: &Library, pool: &mut Pool, run: &Run) -> Result<Outcome, St
             for (d, &i) in dampers.iter_mut().zip(&floors) {
                 d.set_inputs(t, ag + a0[i], vg + v[i], xg + x[i])?;
             }
-            let mut rates = Vec::with_capacity(nd);
+            rates.clear();
             for d in dampers.iter_mut() {
                 rates.push(d.force_rate()?);
             }
-            on_floors(&mut df, &mut rates.into_iter());
+            on_floors(&mut df, &mut rates.iter().copied());
             mat_vec(s.c, &a0, &mut s.cv);
             mat_vec(s.k, &v, &mut s.kx);
             for i in 0..n {
