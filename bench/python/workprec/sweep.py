@@ -176,7 +176,9 @@ def sweep_throughput(fmu: Path, quick: bool):
         example, repeats = _shrunk(example), 1
         design = _shrunk(design)
         design["study"].update(tuning=design["study"]["tuning"][:2], tanks=design["study"]["tanks"][:2])
-    res = {"quick": quick, "example_steps": _steps(example), "design_steps": _steps(design)}
+    import os
+    res = {"quick": quick, "example_steps": _steps(example), "design_steps": _steps(design),
+           "load_before": os.getloadavg()[0]}
     res["step_cost"] = coupled_step_cost(fmu, example, repeats)
     res["native"] = cluster_runs(fmu, example, "native", (1, 2), repeats)
     res["bare_scaling"] = bare_scaling(fmu, example, repeats)
@@ -184,6 +186,7 @@ def sweep_throughput(fmu: Path, quick: bool):
     # length; runs/s is what compares), once
     res["python"] = cluster_runs(fmu, example, "python", (2,), 1, every=1 if quick else 5)[0]
     res["design"] = whole_study(fmu, "design", design)
+    res["load_after"] = os.getloadavg()[0]
     return res
 
 
@@ -204,7 +207,9 @@ def sweep_section(res) -> list[str]:
          "tld_fmu.building's coupling, batches of runs per dask task, one master per worker), *python* the "
          "Python master (`--engine python`, a task per run). LocalClusters of single-threaded worker processes, "
          "started and warmed before the clock, taking turns; medians of "
-         f"{n1['repeats']} repetitions where stated. Other jobs shared the 2 cores: the numbers are noisy.", "",
+         f"{n1['repeats']} repetitions where stated. Other jobs shared the 2 cores (load average "
+         f"{res['load_before']:.1f} before, {res['load_after']:.1f} after, on 2 cores): the numbers are noisy, and "
+         "the ceiling below says what two workers could get at the time.", "",
          "| target | measured | verdict |", "|---|---|---|",
          f"| example study ≥ 30× faster than the Python path (2 workers each) | native {n2['rps']:.1f} runs/s "
          f"against python {py['rps']:.2f} runs/s (python on {py['runs']} of the study's runs, every 5th, "
