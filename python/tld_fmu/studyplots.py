@@ -95,8 +95,8 @@ def best_tuning(peaks: list[dict], path: Path, zeta: float | None = None, title:
                         textcoords="offset points", xytext=(3, 3), color=f"C{ai}")
     ax.set_xlabel("mass ratio [%]")
     ax.set_ylabel("peak |X| / ground amplitude at the best tuning")
-    ax.set_yscale("log")
-    ax.grid(alpha=0.3, which="both")
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
     ax.legend(fontsize=7, ncol=max(1, len(combos)))
     bare = f"; without dampers {bare_peak_amplification(zeta):.0f}" if zeta else ""
     ax.set_title(f"{title + ': ' if title else ''}the best tuning of each mass ratio (numbers: omega_f / omega_s), "
