@@ -158,7 +158,8 @@ def _master_on_worker(fmu_bytes: bytes, digest: str, master_bytes: bytes, master
         from .native import Master
         exe = Path(unzipdir).parent / f"tld-study-{master_digest[:16]}"
         if not exe.exists():
-            tmp = exe.with_suffix(".part")
+            # a name of this thread's own: threads of one worker may write it at once
+            tmp = exe.with_name(f"{exe.name}.{os.getpid()}.{threading.get_ident()}.part")
             tmp.write_bytes(master_bytes)
             tmp.chmod(0o755)
             tmp.replace(exe)
