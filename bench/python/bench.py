@@ -44,8 +44,9 @@ def main():
     ap.add_argument("--fmu", default=str(FMU))
     ap.add_argument("--out", default=None, help="report directory (default: docs, or "
                     "target/bench/quick with --quick)")
-    ap.add_argument("--only", choices=["study"], help="study: measure the design-study throughput alone and "
-                    "replace its section of the existing report (about 4 minutes)")
+    ap.add_argument("--only", choices=["study", "study-report"], help="study: measure the design-study "
+                    "throughput alone and replace its section of the existing report (about 4 minutes); "
+                    "study-report: rewrite that section from the last measurement (bench/study.json)")
     args = ap.parse_args()
     from tqdm import tqdm
 
@@ -58,7 +59,7 @@ def main():
     # a private copy: a rebuild of target/fmu during the run must not change what is measured
     fmu_copy = WORK / "TLD.fmu"
     shutil.copyfile(args.fmu, fmu_copy)
-    if args.only == "study":
+    if args.only:
         return only_study(args, fmu_copy, out)
     fi = FmuInfo(fmu_copy)
     fi.path = Path(args.fmu)
@@ -139,16 +140,21 @@ def main():
 
 
 def only_study(args, fmu: Path, out: Path):
-    """--only study: the design-study section measured anew and put in place of the report's."""
+    """--only study: the design-study section measured anew and put in place of the report's;
+    --only study-report: the section written again from the last measurement."""
     import subprocess
-    t0 = time.perf_counter()
-    res = sweep_throughput(fmu, args.quick)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO, capture_output=True,
-                            text=True).stdout.strip()
+    saved = out / "bench" / "study.json"
+    if args.only == "study-report":
+        res = json.loads(saved.read_text())
+    else:
+        t0 = time.perf_counter()
+        res = sweep_throughput(fmu, args.quick)
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO, capture_output=True,
+                                text=True).stdout.strip()
+        res["measured"] = (f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} by "
+                           f"`scripts/bench --only study` on {commit} in {time.perf_counter() - t0:.0f} s.")
     section = sweep_section(res)
-    section.insert(2, f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} by "
-                      f"`scripts/bench --only study` on {commit} in {time.perf_counter() - t0:.0f} s.")
-    section.insert(3, "")
+    section[2:2] = [res.get("measured", ""), ""]
     md = out / "BENCHMARKS.md"
     text = md.read_text() if md.exists() else "# TLD.fmu work-precision benchmark\n\n## Reproduce\n"
     head = "## Design-study throughput"
@@ -159,10 +165,10 @@ def only_study(args, fmu: Path, out: Path):
     else:
         end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
     md.write_text("\n".join(lines[:start] + section + lines[end:]))
-    (out / "bench").mkdir(parents=True, exist_ok=True)
-    (out / "bench" / "study.json").write_text(json.dumps(res, indent=1, default=str))
+    saved.parent.mkdir(parents=True, exist_ok=True)
+    saved.write_text(json.dumps(res, indent=1, default=str))
     print("\n".join(section))
-    print(f"wrote {md} (its design-study section) and {out / 'bench' / 'study.json'}")
+    print(f"wrote {md} (its design-study section) and {saved}")
 
 
 if __name__ == "__main__":
