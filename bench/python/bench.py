@@ -44,6 +44,9 @@ def main():
     ap.add_argument("--fmu", default=str(FMU))
     ap.add_argument("--out", default=None, help="report directory (default: docs, or "
                     "target/bench/quick with --quick)")
+    ap.add_argument("--only", choices=["study", "study-report"], help="study: measure the design-study "
+                    "throughput alone and replace its section of the existing report (about 4 minutes); "
+                    "study-report: rewrite that section from the last measurement (bench/study.json)")
     args = ap.parse_args()
     from tqdm import tqdm
 
@@ -56,6 +59,8 @@ def main():
     # a private copy: a rebuild of target/fmu during the run must not change what is measured
     fmu_copy = WORK / "TLD.fmu"
     shutil.copyfile(args.fmu, fmu_copy)
+    if args.only:
+        return only_study(args, fmu_copy, out)
     fi = FmuInfo(fmu_copy)
     fi.path = Path(args.fmu)
     print(f"FMU {args.fmu} (sha256 {fi.sha256[:16]}), solver items: "
@@ -114,8 +119,7 @@ def main():
     t0 = time.perf_counter()
     sweep_result = sweep_throughput(fmu_copy, args.quick)
     timings["sweep throughput"] = time.perf_counter() - t0
-    for label, n, w, rps in sweep_result[0]:
-        print(f"  sweep: {label}: {n} runs in {w:.2f} s = {rps:.2f} runs/s", flush=True)
+    print("\n".join(sweep_section(sweep_result)), flush=True)
 
     t0 = time.perf_counter()
     plots(scenes, rows, img, "")
@@ -133,6 +137,38 @@ def main():
     print(f"wrote {out / 'BENCHMARKS.md'} and {img}/ in {timings['total']:.0f} s")
     for k, v in tgt["summary"].items():
         print(f"  target ({k}): {v}")
+
+
+def only_study(args, fmu: Path, out: Path):
+    """--only study: the design-study section measured anew and put in place of the report's;
+    --only study-report: the section written again from the last measurement."""
+    import subprocess
+    saved = out / "bench" / "study.json"
+    if args.only == "study-report":
+        res = json.loads(saved.read_text())
+    else:
+        t0 = time.perf_counter()
+        res = sweep_throughput(fmu, args.quick)
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO, capture_output=True,
+                                text=True).stdout.strip()
+        res["measured"] = (f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} by "
+                           f"`scripts/bench --only study` on {commit} in {time.perf_counter() - t0:.0f} s.")
+    section = sweep_section(res)
+    section[2:2] = [res.get("measured", ""), ""]
+    md = out / "BENCHMARKS.md"
+    text = md.read_text() if md.exists() else "# TLD.fmu work-precision benchmark\n\n## Reproduce\n"
+    head = "## Design-study throughput"
+    lines = text.split("\n")
+    start = next((i for i, l in enumerate(lines) if l.startswith(head)), None)
+    if start is None:
+        start = end = next(i for i, l in enumerate(lines) if l.startswith("## Reproduce"))
+    else:
+        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
+    md.write_text("\n".join(lines[:start] + section + lines[end:]))
+    saved.parent.mkdir(parents=True, exist_ok=True)
+    saved.write_text(json.dumps(res, indent=1, default=str))
+    print("\n".join(section))
+    print(f"wrote {md} (its design-study section) and {saved}")
 
 
 if __name__ == "__main__":

@@ -9,7 +9,9 @@ Modules (imported on demand; none is loaded by importing the package):
   slave      one FMU instance driven through fmpy, with its log captured and fast fixed-step runs
   sdof       the Table 2.1 structure and its co-simulation master (scripts/demo.py, fig25.py)
   building   an N-storey shear building master with TLD.fmu instances (scripts/building.py)
-  study      design studies on dask.distributed (scripts/sweep.py)
+  study      design studies on dask.distributed (scripts/sweep.py); studyfile (the study TOML,
+             checked), studyplots (heat maps, design chart)
+  native     the client of tools' tld-study, the design studies' compiled master
   peaks      a response peak located to a stated tolerance by golden-section search from a sweep's
              grid (scripts/demo.py, building.py, fig25.py, study)
   scenes     the work-precision benchmark's scenes, references and job lines (bench/python/bench.py,

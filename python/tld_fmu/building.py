@@ -197,6 +197,17 @@ class DamperPool:
         self.dampers = []
 
 
+def structure(cfg, inactive) -> Building:
+    """The building of cfg with the dampers' inactive liquid on their floors: inactive is
+    [(0-based floor, mass.inactive)], one per damper (simulate's, and tld_fmu.study's native
+    engine's, which hands the matrices to the compiled master)."""
+    b = cfg["building"]
+    extra = np.zeros(len(b["masses"]))
+    for floor, m in inactive:
+        extra[floor] += m
+    return Building(b["masses"], b["stiffnesses"], b["rayleigh"], extra)
+
+
 def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_forces=None, pool=None,
              derivatives=False):
     """Co-simulate; ground(t) -> (a_g, v_g, x_g). floor_forces, if given, is an array of external
@@ -209,17 +220,14 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
     at the step's start and d(base.a)/dt = (F' - C A - K V)_floor / m_floor (F' from the
     dampers' force rates and the external forces' slope over the step), and the building steps
     with every damper's force extrapolated from its value and exact rate at the step's start."""
-    b = cfg["building"]
-    n = len(b["masses"])
+    n = len(cfg["building"]["masses"])
     dampers = []
-    extra = np.zeros(n)
     if with_dampers:
         for k, d in enumerate(cfg.get("dampers", [])):
             args = (d["floor"], d.get("tanks", 1), d.get("params", {}))
             dp = pool.get(k, *args) if pool is not None else Damper(unzipdir, md, *args, f"tld{k}")
             dampers.append(dp)
-            extra[dp.floor] += dp.inactive
-    bld = Building(b["masses"], b["stiffnesses"], b["rayleigh"], extra)
+    bld = structure(cfg, [(dp.floor, dp.inactive) for dp in dampers])
     steps = int(round(duration / h))
     X, V = np.zeros(n), np.zeros(n)
     out = {"t": np.arange(steps + 1) * h, "X": np.zeros((steps + 1, n)), "A": np.zeros((steps + 1, n)),

@@ -58,20 +58,29 @@ class Contract:
             return self.item(name, value)
         return value
 
-    def set(self, fmu, values: dict):
-        """Set {name: value} on an fmpy FMU2Slave, each through its type's setter (an
-        Enumeration's item by name or value)."""
+    def typed(self, values: dict) -> list[tuple[int, str, object]]:
+        """{name: value} as [(value reference, setter, value)] in the dict's order, setter one
+        of "real", "integer" (an Enumeration's too, its item by name or value) and "boolean"."""
+        out = []
         for name, value in values.items():
             v = self.variable(name)
             value = self.value(name, value)
             if v.type == "Real":
-                fmu.setReal([v.valueReference], [float(value)])
+                out.append((v.valueReference, "real", float(value)))
             elif v.type in ("Integer", "Enumeration"):
-                fmu.setInteger([v.valueReference], [int(value)])
+                out.append((v.valueReference, "integer", int(value)))
             elif v.type == "Boolean":
-                fmu.setBoolean([v.valueReference], [bool(value)])
+                out.append((v.valueReference, "boolean", bool(value)))
             else:
                 raise TypeError(f"{name}: type {v.type}")
+        return out
+
+    def set(self, fmu, values: dict):
+        """Set {name: value} on an fmpy FMU2Slave, each through its type's setter (an
+        Enumeration's item by name or value)."""
+        setters = {"real": fmu.setReal, "integer": fmu.setInteger, "boolean": fmu.setBoolean}
+        for vr, setter, value in self.typed(values):
+            setters[setter]([vr], [value])
 
 
 @functools.cache

@@ -1,26 +1,39 @@
 """Design studies with TLD.fmu on dask.distributed: every combination of tuning ratio x mass ratio
-(number of tanks) x ground amplitude x excitation frequency of a study file is one co-simulation
-of a one-mode structure with the dampers on it (tld_fmu.building's master), run as one dask
-task. Each worker keeps its FMU instances and reuses them through fmi2Reset. The command line
-(scripts/sweep.py runs `main`):
+(number of tanks) x ground amplitude x excitation frequency of a study file, and of the FMU
+parameters it varies ([study] params = {name = [values]}), is one co-simulation of a one-mode
+structure with the dampers on it. The command line (scripts/sweep.py runs `main`):
 
     .venv/bin/python scripts/sweep.py scripts/examples/study.toml            # LocalCluster, 2 workers
     .venv/bin/python scripts/sweep.py STUDY --workers 1
     .venv/bin/python scripts/sweep.py STUDY --scheduler tcp://host:8786      # an existing cluster
+    .venv/bin/python scripts/sweep.py STUDY --engine python                  # the Python master
 
-The FMU travels to the workers as data (scattered once); the workers of a LocalCluster import
-this package from the venv, those of an existing scheduler get it uploaded (a zip), so a remote
-cluster needs only numpy and fmpy installed.
+Engines: "native" (the default) is the compiled master, tools' tld-study (tld_fmu.native): it
+dlopens TLD.fmu and runs tld_fmu.building's coupling, operation for operation the same, at the
+FMU's speed; the runs go to dask in batches, and each worker thread keeps one master process
+(its FMU instances reused through fmi2Reset). "python" is tld_fmu.building's master, a dask task
+per run, each worker keeping its FMU instances. Both give the same numbers
+(tests/python/test_study_engines.py).
 
-The peak over frequency of each case (tuning x tanks x amplitude) is refined (tld_fmu.peaks):
-the frequency grid brackets the largest response and a golden-section search of further runs,
-all cases in lockstep as dask tasks, locates it to +-xtol in w / w_s (--xtol, default 0.002).
+The FMU (and the master) travel to the workers as data (scattered once); the workers of a
+LocalCluster import this package from the venv, those of an existing scheduler get it uploaded
+(a zip), so a remote cluster needs only numpy and fmpy installed.
+
+The peak over frequency of each case (varied parameters x tuning x tanks x amplitude) is refined
+(tld_fmu.peaks): the frequency grid brackets the largest response and a golden-section search of
+further runs, all cases in lockstep, locates it to +-xtol in w / w_s (--xtol, default 0.002).
+
+A study file is checked first (check_study: unknown keys, impossible values, parameters the
+modelDescription lacks); a run that fails is a row with NaN results and the reason, naming the
+run, and loses no other.
 
 Writes, named after the study file STUDY.toml, into --out (default out/sweep): STUDY.csv (a row
 per run, the refinement runs included and marked), STUDY-peaks.csv (a row per case: the refined
-peak, the grid's, and the tolerance) and STUDY.png (heat maps of the refined peak amplification,
+peak, the grid's, and the tolerance), STUDY.png (heat maps of the refined peak amplification,
 max over frequency of the steady structure displacement / ground displacement, over tuning x mass
-ratio, one panel per amplitude, with the bare structure's value for reference).
+ratio, a panel per amplitude and varied parameter, with the bare structure's value for reference)
+and STUDY-best.png (the design chart: the best tuning's peak amplification against the mass
+ratio, a line per amplitude and varied parameter).
 """
 from __future__ import annotations
 
@@ -32,7 +45,6 @@ import os
 import tempfile
 import threading
 import time
-import tomllib
 import zipfile
 from pathlib import Path
 
@@ -41,8 +53,8 @@ import numpy as np
 from . import building
 from . import peaks as pk
 from .paths import FMU, REPO
-COLUMNS = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "frequency_ratio", "omega_s",
-           "peak_displacement", "amplification"]
+from .studyfile import COLUMNS, StudyError, check_study, dump_study, load_study  # noqa: F401 (this module's API)
+from .studyplots import bare_peak_amplification, best_tuning, heat_maps  # noqa: F401
 
 _local = threading.local()   # per worker thread: {digest: (unzipdir, md, pool)}
 
@@ -72,32 +84,53 @@ def probe(unzipdir, md, params, tanks):
     return values
 
 
+def axes(study: dict) -> list[str]:
+    """The FMU parameters the study varies ([study] params = {NAME = [values]}), in order."""
+    return list(study["study"].get("params", {}))
+
+
+def variants(study: dict) -> list[dict]:
+    """Every combination of the varied FMU parameters' values ([{}] if none is varied)."""
+    p = study["study"].get("params", {})
+    return [dict(zip(p, combo)) for combo in itertools.product(*p.values())]
+
+
 def expand(study: dict, unzipdir, md) -> list[dict]:
     """The runs of a study: one dict per combination, with the structure that realises it."""
     st, sw = study["structure"], study["study"]
     params = study.get("damper", {}).get("params", {})
     f0, f1, nf = sw["frequency"]
     runs = []
-    for tanks in sw["tanks"]:
-        w_f, m_liquid, m_inactive = probe(unzipdir, md, params, tanks)
-        for tuning, amp, r in itertools.product(sw["tuning"], sw["ground_amplitude"], np.linspace(f0, f1, int(nf))):
-            w_s = w_f / tuning
-            runs.append({"tuning": tuning, "tanks": tanks, "mass_ratio": m_liquid / st["mass"],
-                         "ground_amplitude": amp, "frequency_ratio": float(r), "omega_s": w_s,
-                         # the inactive liquid moves with the structure: K tunes M + inactive
-                         "stiffness": (st["mass"] + m_inactive) * w_s ** 2})
+    for variant in variants(study):
+        for tanks in sw["tanks"]:
+            w_f, m_liquid, m_inactive = probe(unzipdir, md, {**params, **variant}, tanks)
+            for tuning, amp, r in itertools.product(sw["tuning"], sw["ground_amplitude"], np.linspace(f0, f1, int(nf))):
+                w_s = w_f / tuning
+                runs.append({"index": len(runs), **variant, "params": variant, "tuning": tuning, "tanks": tanks,
+                             "mass_ratio": m_liquid / st["mass"],
+                             "ground_amplitude": amp, "frequency_ratio": float(r), "omega_s": w_s,
+                             # the inactive liquid moves with the structure: K tunes M + inactive
+                             "stiffness": (st["mass"] + m_inactive) * w_s ** 2, "inactive": m_inactive})
     return runs
 
 
-def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool = False) -> dict:
-    """One co-simulation; returns the run's row plus where it ran and how many instances its
-    thread has created so far. fresh=True: a new instance instead of the pool (for checks)."""
-    unzipdir, md, pool = _fmu_on_worker(fmu_bytes, digest)
-    st, rn = study["structure"], study["run"]
+def _config(study: dict, run: dict) -> tuple[dict, float, float]:
+    """A run as tld_fmu.building's master takes it: (cfg, w, ground amplitude)."""
+    st = study["structure"]
     cfg = {"building": {"masses": [st["mass"]], "stiffnesses": [run["stiffness"]],
                         "rayleigh": [st["damping"], st["damping"]]},
-           "dampers": [{"floor": 1, "tanks": run["tanks"], "params": study.get("damper", {}).get("params", {})}]}
-    w, a = run["frequency_ratio"] * run["omega_s"], run["ground_amplitude"]
+           "dampers": [{"floor": 1, "tanks": run["tanks"],
+                        "params": {**study.get("damper", {}).get("params", {}), **run.get("params", {})}}]}
+    return cfg, run["frequency_ratio"] * run["omega_s"], run["ground_amplitude"]
+
+
+def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool = False) -> dict:
+    """One co-simulation by the Python master; returns the run's row plus where it ran and how
+    many instances its thread has created so far. fresh=True: a new instance instead of the
+    pool (for checks)."""
+    unzipdir, md, pool = _fmu_on_worker(fmu_bytes, digest)
+    rn = study["run"]
+    cfg, w, a = _config(study, run)
     s = building.simulate(cfg, unzipdir, md, building.harmonic_ground(w, a), rn["step"], rn["duration"], pool=None if fresh else pool,
                           derivatives=bool(rn.get("derivatives", False)))
     tail = s["t"] > rn["duration"] - rn["tail"]
@@ -106,50 +139,177 @@ def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool =
                 worker=f"{os.getpid()}/{threading.get_ident()}", instances=len(pool.dampers), error="")
 
 
+def run_name(run: dict) -> str:
+    """A run as its error messages name it."""
+    return (f"run {run['index']} (tuning {run['tuning']:g}, {run['tanks']} tank(s), ground amplitude "
+            f"{run['ground_amplitude']:g} m, w/w_s {run['frequency_ratio']:g})")
+
+
+def _master_on_worker(fmu_bytes: bytes, digest: str, master_bytes: bytes, master_digest: str):
+    """This thread's compiled master (a tld-study process with the FMU loaded), started on first
+    use and again if it has died; the binary is written next to the unpacked FMU."""
+    unzipdir, md, _ = _fmu_on_worker(fmu_bytes, digest)
+    masters = getattr(_local, "masters", None)
+    if masters is None:
+        masters = _local.masters = {}
+    key = (digest, master_digest)
+    m = masters.get(key)
+    if m is None or not m.alive():
+        from .native import Master
+        exe = Path(unzipdir).parent / f"tld-study-{master_digest[:16]}"
+        if not exe.exists():
+            # a name of this thread's own: threads of one worker may write it at once
+            tmp = exe.with_name(f"{exe.name}.{os.getpid()}.{threading.get_ident()}.part")
+            tmp.write_bytes(master_bytes)
+            tmp.chmod(0o755)
+            tmp.replace(exe)
+        m = masters[key] = Master(exe, unzipdir, md)
+    return m, md
+
+
+def run_batch(fmu_bytes: bytes, digest: str, master_bytes: bytes, master_digest: str, study: dict,
+              runs: list[dict]) -> list[dict]:
+    """Runs by the compiled master, one request for the batch; a row per run (a failed run's
+    row carries its error)."""
+    from .contract import Contract
+    from .native import request
+    m, md = _master_on_worker(fmu_bytes, digest, master_bytes, master_digest)
+    rn = study["run"]
+    contract = Contract(md)
+    reqs = []
+    for r in runs:
+        cfg, w, a = _config(study, r)
+        reqs.append(request(run_name(r), cfg, contract, [r["inactive"]], w, a, rn["step"], rn["duration"],
+                            rn["tail"], bool(rn.get("derivatives", False))))
+    where = f"{os.getpid()}/{threading.get_ident()}"
+    rows = []
+    for r, got in zip(runs, m.run(reqs)):
+        if "error" in got:
+            rows.append(failed_row(r, RuntimeError(got["error"])))
+        else:
+            peak = got["peak"][0]
+            rows.append(_row(r, peak_displacement=peak, amplification=peak / r["ground_amplitude"],
+                             worker=where, instances=got["instances"], error=""))
+    return rows
+
+
+ENGINES = ("native", "python")
+
+
+def master_binary() -> Path:
+    """The compiled master: $TLD_STUDY_MASTER, else tools' tld-study built (release) by cargo."""
+    from .paths import cargo_executable
+    env = os.environ.get("TLD_STUDY_MASTER")
+    return Path(env) if env else cargo_executable("tld-study", release=True)
+
+
+class Executor:
+    """Runs lists of runs of one study with one engine, here (client None) or on a dask client:
+    the python engine a task per run (the Python master), the native engine a task per batch of
+    runs (the compiled master, one per worker thread). The FMU (and the master) travel to the
+    workers as data, once."""
+
+    def __init__(self, study: dict, fmu_path: Path, client=None, engine: str = "native"):
+        if engine not in ENGINES:
+            raise ValueError(f"engine {engine!r}: one of {', '.join(ENGINES)}")
+        self.study, self.client, self.engine = study, client, engine
+        self.fmu_bytes = Path(fmu_path).read_bytes()
+        self.digest = hashlib.sha256(self.fmu_bytes).hexdigest()
+        self.unzipdir, self.md, _ = _fmu_on_worker(self.fmu_bytes, self.digest)
+        if engine == "native":
+            self.master_bytes = master_binary().read_bytes()
+            self.master_digest = hashlib.sha256(self.master_bytes).hexdigest()
+        self.data = self.master_data = None
+        if client is not None:
+            # fresh keys: no race with a released earlier scatter
+            self.data = client.scatter(self.fmu_bytes, broadcast=True, hash=False)
+            if engine == "native":
+                self.master_data = client.scatter(self.master_bytes, broadcast=True, hash=False)
+
+    def batch_size(self, n: int) -> int:
+        """Runs per task: about 8 tasks per worker thread (load balance at the end, progress),
+        at most 64 runs (the task overhead is then < 1 %)."""
+        threads = sum(self.client.nthreads().values()) if self.client is not None else 1
+        return max(1, min(64, math.ceil(n / (8 * threads))))
+
+    def run(self, runs: list[dict], bar=None) -> list[dict]:
+        """The runs' rows, in their order; a run that failed is a row with NaN results and the
+        reason (the others are not lost)."""
+        rows: list = [None] * len(runs)
+        if self.engine == "python":
+            chunks = [[i] for i in range(len(runs))]
+        else:
+            b = self.batch_size(len(runs))
+            chunks = [list(range(i, min(i + b, len(runs)))) for i in range(0, len(runs), b)]
+
+        def done(idx, result=None, error=None):
+            for j, i in enumerate(idx):
+                rows[i] = result[j] if error is None else failed_row(runs[i], error)
+            if bar is not None:
+                bar.update(len(idx))
+
+        if self.client is None:
+            for idx in chunks:
+                try:
+                    done(idx, self._call(self.fmu_bytes, self.master_bytes if self.engine == "native" else None,
+                                         [runs[i] for i in idx]))
+                except Exception as e:   # one failed run (or batch) must not lose the others
+                    done(idx, error=e)
+            return rows
+        from distributed import as_completed
+        if self.engine == "python":
+            futures = self.client.map(run_one, [self.data] * len(runs), [self.digest] * len(runs),
+                                      [self.study] * len(runs), runs, pure=False)
+        else:
+            futures = self.client.map(run_batch, [self.data] * len(chunks), [self.digest] * len(chunks),
+                                      [self.master_data] * len(chunks), [self.master_digest] * len(chunks),
+                                      [self.study] * len(chunks), [[runs[i] for i in idx] for idx in chunks],
+                                      pure=False)
+        index = {f.key: idx for f, idx in zip(futures, chunks)}
+        for f in as_completed(futures):
+            idx = index[f.key]
+            try:
+                got = f.result()
+                done(idx, [got] if self.engine == "python" else got)
+            except Exception as e:
+                done(idx, error=e)
+        return rows
+
+    def _call(self, fmu_bytes, master_bytes, runs):
+        if self.engine == "python":
+            return [run_one(fmu_bytes, self.digest, self.study, runs[0])]
+        return run_batch(fmu_bytes, self.digest, master_bytes, self.master_digest, self.study, runs)
+
+
 def _row(run: dict, **results) -> dict:
     """A table row: the run's parameters and its results."""
-    return {**{k: run[k] for k in COLUMNS if k in run}, **results}
+    return {**run.get("params", {}), **{k: run[k] for k in COLUMNS if k in run}, **results}
 
 
-def run_study(study: dict, fmu_path: Path, client=None, progress=True) -> tuple[list[dict], float]:
-    """All runs of a study, on a dask client (None: here, serially, on one pool). Returns the
-    rows in study order and the wall time of the runs [s]."""
-    fmu_bytes = Path(fmu_path).read_bytes()
-    digest = hashlib.sha256(fmu_bytes).hexdigest()
-    unzipdir, md, _ = _fmu_on_worker(fmu_bytes, digest)
-    runs = expand(study, unzipdir, md)
+def run_study(study: dict, fmu_path: Path, client=None, progress=True, engine: str = "native",
+              executor: Executor | None = None) -> tuple[list[dict], float]:
+    """All runs of a study, on a dask client (None: here, serially), by the compiled master
+    (engine "native") or the Python one ("python"). Returns the rows in study order and the
+    wall time of the runs [s]."""
+    ex = executor or Executor(study, fmu_path, client, engine)
+    runs = expand(study, ex.unzipdir, ex.md)
     from tqdm import tqdm
-    bar = tqdm(total=len(runs), desc="runs", disable=not progress)
+    bar = tqdm(total=len(runs), desc=f"runs ({ex.engine} master)", disable=not progress)
     t0 = time.perf_counter()
-    rows = [None] * len(runs)
-    if client is None:
-        for i, r in enumerate(runs):
-            try:
-                rows[i] = run_one(fmu_bytes, digest, study, r)
-            except Exception as e:   # one failed run must not lose the others
-                rows[i] = failed_row(r, e)
-            bar.update()
-    else:
-        from distributed import as_completed
-        data = client.scatter(fmu_bytes, broadcast=True, hash=False)   # a fresh key: no race with a released earlier scatter
-        futures = client.map(run_one, [data] * len(runs), [digest] * len(runs), [study] * len(runs), runs,
-                             pure=False)
-        index = {f.key: i for i, f in enumerate(futures)}
-        for f in as_completed(futures):
-            i = index[f.key]
-            try:
-                rows[i] = f.result()
-            except Exception as e:
-                rows[i] = failed_row(runs[i], e)
-            bar.update()
+    rows = ex.run(runs, bar)
     bar.close()
     return rows, time.perf_counter() - t0
 
 
 def failed_row(run: dict, error: Exception) -> dict:
-    """A run that raised: its parameters, NaN results and the reason."""
+    """A run that raised: its parameters, NaN results and the reason, which names the run
+    (whichever engine, and whether the run or its whole batch failed)."""
+    text, name = str(error), run_name(run) if "index" in run else ""
+    if name and text.startswith(name + ": "):
+        text = text[len(name) + 2:]
+    msg = f"{name + ': ' if name else ''}{type(error).__name__}: {text}"
     return _row(run, peak_displacement=math.nan, amplification=math.nan, worker="", instances=0,
-                error=f"{type(error).__name__}: {error}".replace(",", ";").replace("\n", " "))
+                error=msg.replace(",", ";").replace("\n", " "))
 
 
 def connect(scheduler: str | None, workers: int):
@@ -189,8 +349,9 @@ def _package_zip(directory: Path) -> str:
     return str(path)
 
 
-def write_table(rows: list[dict], path: Path):
-    cols = COLUMNS + ["worker", "instances", "error"]
+def write_table(rows: list[dict], path: Path, axes: list[str] = ()):
+    """A row per run; axes: the varied FMU parameters' columns (first)."""
+    cols = list(axes) + COLUMNS + ["worker", "instances", "error"]
     if any("refinement" in r for r in rows):
         cols.append("refinement")
         rows = [{"refinement": 0, **r} for r in rows]
@@ -201,50 +362,36 @@ def write_table(rows: list[dict], path: Path):
 
 
 def _case(r: dict) -> tuple:
-    return (r["tuning"], r["tanks"], r["ground_amplitude"])
+    """The case of a run (what its peak over frequency belongs to)."""
+    return (tuple(r.get("params", {}).items()), r["tuning"], r["tanks"], r["ground_amplitude"])
 
 
 def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xtol: float = 2e-3,
-                 progress=True) -> tuple[list[dict], list[dict]]:
+                 progress=True, engine: str = "native", executor: Executor | None = None
+                 ) -> tuple[list[dict], list[dict]]:
     """The peak over frequency of every case of a study (tuning x tanks x amplitude), refined from
     the grid runs `rows` (run_study's) by golden-section search to xtol in w / w_s; the searches of
     all cases advance in lockstep, one round of runs at a time (dask tasks on a client, else
-    serially). Returns (peaks: a row per case, the refinement runs' rows). A case whose grid
-    has a failed run is not refined (its peak row says so)."""
-    fmu_bytes = Path(fmu_path).read_bytes()
-    digest = hashlib.sha256(fmu_bytes).hexdigest()
-    unzipdir, md, _ = _fmu_on_worker(fmu_bytes, digest)
-    runs = expand(study, unzipdir, md)
+    serially). Returns (peaks: a row per case, the refinement runs' rows, numbered on from the
+    grid's). A case whose grid has a failed run is not refined (its peak row says so)."""
+    ex = executor or Executor(study, fmu_path, client, engine)
+    runs = expand(study, ex.unzipdir, ex.md)
     cases: dict[tuple, list[int]] = {}
     for i, r in enumerate(runs):
         cases.setdefault(_case(r), []).append(i)
     curves = {c: ([runs[i]["frequency_ratio"] for i in idx], [rows[i]["amplification"] for i in idx])
               for c, idx in cases.items() if not any(math.isnan(rows[i]["amplification"]) for i in idx)}
-    data = None
-    if client is not None:
-        data = client.scatter(fmu_bytes, broadcast=True, hash=False)
     from tqdm import tqdm
-    bar = tqdm(desc="peak refinement runs", disable=not progress)
+    bar = tqdm(desc=f"peak refinement runs ({ex.engine} master)", disable=not progress)
     extra: list[dict] = []
 
     def evaluate(batch):
-        todo = [{**runs[cases[c][0]], "frequency_ratio": float(x)} for c, x in batch]
-        if client is None:
-            got = []
-            for r in todo:
-                try:
-                    got.append(run_one(fmu_bytes, digest, study, r))
-                except Exception as e:
-                    got.append(failed_row(r, e))
-        else:
-            futures = client.map(run_one, [data] * len(todo), [digest] * len(todo), [study] * len(todo), todo,
-                                 pure=False)
-            got = [f.result() if f.status == "finished" else failed_row(r, f.exception())
-                   for f, r in zip(_wait(futures), todo)]
+        todo = [{**runs[cases[c][0]], "frequency_ratio": float(x), "index": len(runs) + len(extra) + j}
+                for j, (c, x) in enumerate(batch)]
+        got = ex.run(todo, bar)
         for g in got:
             g["refinement"] = 1
         extra.extend(got)
-        bar.update(len(batch))
         return [g["amplification"] for g in got]
 
     # every grid maximum within half of the largest: a tuned damper's two peaks, either of which
@@ -254,7 +401,7 @@ def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xto
     out = []
     for c, idx in cases.items():
         first = rows[idx[0]]
-        base = {k: first[k] for k in ("tuning", "tanks", "mass_ratio", "ground_amplitude")}
+        base = {**runs[idx[0]]["params"], **{k: first[k] for k in ("tuning", "tanks", "mass_ratio", "ground_amplitude")}}
         if c not in found:
             out.append({**base, "peak_frequency_ratio": math.nan, "peak_amplification": math.nan, "xtol": xtol,
                         "grid_frequency_ratio": math.nan, "grid_amplification": math.nan, "bounded": False,
@@ -268,67 +415,17 @@ def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xto
     return out, extra
 
 
-def _wait(futures):
-    from distributed import wait
-    wait(futures)
-    return futures
-
-
 PEAK_COLUMNS = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "peak_frequency_ratio", "peak_amplification",
                 "xtol", "grid_frequency_ratio", "grid_amplification", "bounded", "refinement_runs", "note"]
 
 
-def write_peaks(peaks: list[dict], path: Path):
+def write_peaks(peaks: list[dict], path: Path, axes: list[str] = ()):
+    """A row per case; axes: the varied FMU parameters' columns (first)."""
+    cols = list(axes) + PEAK_COLUMNS
     with open(path, "w") as fh:
-        fh.write(",".join(PEAK_COLUMNS) + "\n")
+        fh.write(",".join(cols) + "\n")
         for r in peaks:
-            fh.write(",".join(repr(r[c]) if isinstance(r[c], float) else str(r[c]) for c in PEAK_COLUMNS) + "\n")
-
-
-def bare_peak_amplification(zeta: float) -> float:
-    """The bare one-mode structure's largest steady |X| / A_g under x_g = A_g sin(w t), closed
-    form: max over r of r^2 / sqrt((1 - r^2)^2 + (2 zeta r)^2) = 1 / (2 zeta sqrt(1 - zeta^2))."""
-    return 1.0 / (2.0 * zeta * math.sqrt(1.0 - zeta * zeta))
-
-
-def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: str = ""):
-    """Refined peak amplification over tuning x mass ratio, a panel per amplitude; the bare
-    structure's (closed form, damping ratio zeta) for reference."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    tunings = sorted({r["tuning"] for r in peaks})
-    ratios = sorted({r["mass_ratio"] for r in peaks})
-    amps = sorted({r["ground_amplitude"] for r in peaks if not math.isnan(r["ground_amplitude"])})
-    fig, axes = plt.subplots(1, max(1, len(amps)), figsize=(4.8 * max(1, len(amps)), 4.4), squeeze=False)
-    bare = bare_peak_amplification(zeta) if zeta else None
-    for ax, amp in zip(axes[0], amps):
-        Z = np.full((len(ratios), len(tunings)), np.nan)
-        edge = np.zeros_like(Z, dtype=bool)
-        for r in peaks:
-            if r["ground_amplitude"] == amp:
-                i, j = ratios.index(r["mass_ratio"]), tunings.index(r["tuning"])
-                Z[i, j], edge[i, j] = r["peak_amplification"], not r["bounded"]
-        im = ax.imshow(Z, origin="lower", aspect="auto", cmap="viridis")
-        ax.set_xticks(range(len(tunings)), [f"{t:.2f}" for t in tunings])
-        ax.set_yticks(range(len(ratios)), [f"{100 * m:.2g} %" for m in ratios])
-        for i, j in itertools.product(range(len(ratios)), range(len(tunings))):
-            text = f"{Z[i, j]:.0f}" + ("*" if edge[i, j] else "")
-            if bare:
-                text += f"\n{100 * (1 - Z[i, j] / bare):.0f} % less"
-            ax.text(j, i, text, ha="center", va="center", color="w", fontsize=7)
-        ax.set_xlabel(r"tuning $\omega_f / \omega_s$")
-        ax.set_ylabel("mass ratio")
-        ax.set_title(f"ground amplitude {amp * 1e3:g} mm", fontsize=10)
-        fig.colorbar(im, ax=ax, label="peak |X| / ground amplitude")
-    head = f"{title}: " if title else ""
-    ref = (f"without dampers {bare:.0f} (closed form 1/(2 zeta sqrt(1 - zeta^2)), zeta = {100 * zeta:g} %)"
-           if bare else "")
-    fig.suptitle(f"{head}peak amplification over frequency, refined; {ref}\n"
-                 "* = at the edge of the frequency range (the peak may lie outside)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+            fh.write(",".join(repr(r[c]) if isinstance(r[c], float) else str(r[c]) for c in cols) + "\n")
 
 
 def main(argv=None):
@@ -342,17 +439,25 @@ def main(argv=None):
                     help="directory for STUDY.csv, STUDY-peaks.csv and STUDY.png (default out/sweep)")
     ap.add_argument("--xtol", type=float, default=2e-3,
                     help="tolerance of the refined peak frequencies, in w / w_s (default 0.002)")
+    ap.add_argument("--engine", choices=ENGINES, default="native",
+                    help="native (default): the compiled master, tools' tld-study, batches of runs per task; "
+                         "python: tld_fmu.building's master, a task per run")
     args = ap.parse_args(argv)
-    study = tomllib.loads(Path(args.study).read_text())
+    from .contract import Contract
+    try:
+        study = load_study(Path(args.study), Contract(args.fmu))
+    except StudyError as e:
+        raise SystemExit(f"scripts/sweep.py: {e}") from None
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     client = cluster = None
     if not args.serial:
         client, cluster = connect(args.scheduler, args.workers)
     try:
-        rows, wall = run_study(study, Path(args.fmu), client)
+        ex = Executor(study, Path(args.fmu), client, args.engine)
+        rows, wall = run_study(study, Path(args.fmu), executor=ex)
         t0 = time.perf_counter()
-        peaks, extra = refine_study(study, Path(args.fmu), rows, client, args.xtol)
+        peaks, extra = refine_study(study, Path(args.fmu), rows, xtol=args.xtol, executor=ex)
         wall_refine = time.perf_counter() - t0
     finally:
         if client is not None:
@@ -361,17 +466,19 @@ def main(argv=None):
             cluster.close()
     name = Path(args.study).stem
     table, peaks_file, png = out / f"{name}.csv", out / f"{name}-peaks.csv", out / f"{name}.png"
-    write_table(rows + extra, table)
-    write_peaks(peaks, peaks_file)
-    heat_maps(peaks, png, study["structure"].get("damping"), name)
+    write_table(rows + extra, table, axes(study))
+    write_peaks(peaks, peaks_file, axes(study))
+    heat_maps(peaks, png, study["structure"].get("damping"), name, axes(study))
+    chart = out / f"{name}-best.png"
+    best_tuning(peaks, chart, study["structure"].get("damping"), name, axes(study))
     where = "serial" if args.serial else (args.scheduler or f"LocalCluster, {args.workers} workers")
     failed = [r for r in rows if r["error"]]
     if failed:
         print(f"{len(failed)} of {len(rows)} runs failed (NaN in the table, reason in its 'error' column); "
               f"first: {failed[0]['error']}")
-    print(f"{len(rows)} runs in {wall:.1f} s ({len(rows) / wall:.2f} runs/s, {where}); "
+    print(f"{len(rows)} runs in {wall:.1f} s ({len(rows) / wall:.2f} runs/s, {where}, {args.engine} master); "
           f"{len({r['worker'] for r in rows})} worker threads, at most {max(r['instances'] for r in rows)} "
           f"FMU instance(s) each; then {len(extra)} refinement runs in {wall_refine:.1f} s "
           f"(peaks to +-{args.xtol:g} w_s)")
-    print(f"wrote {table}, {peaks_file}, {png}")
+    print(f"wrote {table}, {peaks_file}, {png}, {chart}")
     return rows

@@ -111,20 +111,12 @@ def test_outputs_are_named_after_the_study_file(fmu_path, tmp_path):
         sweep.main([str(tmp_path / f"{name}.toml"), "--serial", "--fmu", str(fmu_path), "--out",
                     str(tmp_path / "out"), "--xtol", "0.02"])
     written = sorted(p.name for p in (tmp_path / "out").iterdir())
-    assert written == ["small_tank-peaks.csv", "small_tank.csv", "small_tank.png",
-                       "tall_building-peaks.csv", "tall_building.csv", "tall_building.png"]
+    assert written == ["small_tank-best.png", "small_tank-peaks.csv", "small_tank.csv", "small_tank.png",
+                       "tall_building-best.png", "tall_building-peaks.csv", "tall_building.csv",
+                       "tall_building.png"]
 
 
-def toml(d: dict) -> str:
-    """A minimal TOML writer for the study dict (tables of scalars, lists and inline tables)."""
-    def value(v):
-        if isinstance(v, dict):
-            return "{ " + ", ".join(f'"{k}" = {value(x)}' for k, x in v.items()) + " }"
-        if isinstance(v, list):
-            return "[" + ", ".join(value(x) for x in v) + "]"
-        return repr(v)
-    return "".join(f"[{name}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in table.items())
-                   for name, table in d.items())
+toml = sweep.dump_study
 
 
 @pytest.mark.parametrize("where", ["serial", "dask"])
