@@ -258,6 +258,7 @@ def quake(cfg, unzipdir, md, out, plt, args):
                  f"({100 * (1 - ring[1] / ring[0]):.0f} % less)", fontsize=9)
     ax.legend(fontsize=8, loc="upper right")
     ax.grid(alpha=0.3)
+    ax.axvline(T - args.tail, color="k", lw=0.6, ls=":", label="end of the record")
     ax2 = ax.twinx()
     ax2.plot(s["t"], ground_a, color="C3", lw=0.4, alpha=0.35)
     ax2.set_ylabel("ground acceleration [m/s2]", color="C3")
