@@ -253,12 +253,12 @@ def quake(cfg, unzipdir, md, out, plt, args):
     ax = fig.add_subplot(gs[1, :])
     ax.plot(bare["t"], 1e3 * bare["X"][:, -1], color="0.4", lw=0.6, label="without dampers")
     ax.plot(s["t"], 1e3 * s["X"][:, -1], "C0", lw=0.6, label="with TLD.fmu")
+    ax.axvline(T - args.tail, color="k", lw=0.6, ls=":", label="end of the record")
     ax.set_ylabel("roof displacement [mm]")
     ax.set_title(f"after the record: roof vibration about its residual {1e3 * ring[0]:.2f} -> {1e3 * ring[1]:.2f} mm rms "
                  f"({100 * (1 - ring[1] / ring[0]):.0f} % less)", fontsize=9)
     ax.legend(fontsize=8, loc="upper right")
     ax.grid(alpha=0.3)
-    ax.axvline(T - args.tail, color="k", lw=0.6, ls=":", label="end of the record")
     ax2 = ax.twinx()
     ax2.plot(s["t"], ground_a, color="C3", lw=0.4, alpha=0.35)
     ax2.set_ylabel("ground acceleration [m/s2]", color="C3")
