@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from tld_fmu import peaks as pk
-from tld_fmu.building import Building, harmonic_ground, simulate, wind_forces
+from tld_fmu.building import Building, harmonic_ground, record_ground, simulate, wind_forces
 from tld_fmu.paths import FMU, REPO
 
 
@@ -54,11 +54,8 @@ def main(argv=None):
     elif load["kind"] in ("record", "wind"):
         if load["kind"] == "record":
             rec = np.loadtxt(Path(args.config).parent / load["record"], delimiter=",")
-            tt, aa = rec[:, 0], rec[:, 1]
-            vv = np.concatenate([[0], np.cumsum((aa[1:] + aa[:-1]) / 2 * np.diff(tt))])
-            xx = np.concatenate([[0], np.cumsum((vv[1:] + vv[:-1]) / 2 * np.diff(tt))])
-            ground = lambda t: (np.interp(t, tt, aa), np.interp(t, tt, vv), np.interp(t, tt, xx))  # noqa: E731
-            duration, forces = tt[-1], None
+            ground = record_ground(rec[:, 0], rec[:, 1])
+            duration, forces = rec[-1, 0], None
         else:
             duration = load["duration"]
             ground = lambda t: (0.0, 0.0, 0.0)  # noqa: E731

@@ -35,6 +35,7 @@ class Building:
         # Rayleigh: zeta_i = a0 / (2 w_i) + a1 w_i / 2 for modes 1 and 2
         A = np.array([[1 / (2 * w[0]), w[0] / 2], [1 / (2 * w[1]), w[1] / 2]])
         a0, a1 = np.linalg.solve(A, [z1, z2]) if n > 1 else (0.0, 2 * z1 / w[0])
+        self.rayleigh_coefficients = (float(a0), float(a1))   # C = a0 M + a1 K
         self.C = a0 * self.M + a1 * K
         self.minv = 1.0 / m
         self.omega1 = w[0]
@@ -47,6 +48,38 @@ class Building:
 
     def accel(self, X, V, F, ag):
         return self.minv * (F - self.C @ V - self.K @ X) - ag
+
+
+def monolithic(bld, dampers, ground, t_eval, floor_forces=None, rtol=1e-11, atol=1e-14):
+    """The reference for a co-simulation with linear dampers (model = Linear, modes = 1, damping
+    Constant): building and sloshing modes as one ODE system, integrated by scipy's DOP853.
+
+        M X'' + C X' + K X = -M 1 a_g + sum_d e_d m_d (c_d x_d' + w_d^2 x_d) + f(t)
+        x_d'' + c_d x_d' + w_d^2 x_d = -(a_g + X_floor(d)'')
+
+    bld: the Building with the dampers' inactive masses in M; dampers: [(floor index from 0,
+    slosh mass m_d, w_d, zeta_d)]; ground(t) -> (a_g, ...); floor_forces(t) -> f (or None).
+    Returns the floors' displacements relative to the ground at t_eval, shape (len, n)."""
+    from scipy.integrate import solve_ivp
+    n, nd = bld.n, len(dampers)
+    floor = [d[0] for d in dampers]
+    m_d = np.array([d[1] for d in dampers], float)
+    w_d = np.array([d[2] for d in dampers], float)
+    c_d = 2 * np.array([d[3] for d in dampers], float) * w_d
+
+    def rhs(t, y):
+        X, V, x, v = y[:n], y[n:2 * n], y[2 * n:2 * n + nd], y[2 * n + nd:]
+        F = np.zeros(n) if floor_forces is None else np.array(floor_forces(t), float)
+        np.add.at(F, floor, m_d * (c_d * v + w_d ** 2 * x))
+        ag = ground(t)[0]
+        A = bld.accel(X, V, F, ag)
+        return np.concatenate([V, A, v, -(ag + A[floor]) - c_d * v - w_d ** 2 * x])
+
+    ref = solve_ivp(rhs, (t_eval[0], t_eval[-1]), np.zeros(2 * (n + nd)), method="DOP853", rtol=rtol,
+                    atol=atol, t_eval=t_eval)
+    if not ref.success:
+        raise RuntimeError(f"monolithic reference: {ref.message}")
+    return ref.y[:n].T
 
 
 def wind_forces(n_floors, dt, n, force_rms, band, corner, coherence, seed):
@@ -88,6 +121,15 @@ def wind_forces(n_floors, dt, n, force_rms, band, corner, coherence, seed):
         F[:nfft, i] = rms[i] * g / np.sqrt(np.mean(g ** 2))
     F[nfft] = F[0]
     return np.arange(nfft + 1) * dt, F
+
+
+def record_ground(tt, aa):
+    """A ground-acceleration record (times tt, accelerations aa) as ground(t) -> (a_g, v_g, x_g):
+    velocity and displacement by the trapezoidal rule from rest, all linear between samples."""
+    tt, aa = np.asarray(tt, float), np.asarray(aa, float)
+    vv = np.concatenate([[0], np.cumsum((aa[1:] + aa[:-1]) / 2 * np.diff(tt))])
+    xx = np.concatenate([[0], np.cumsum((vv[1:] + vv[:-1]) / 2 * np.diff(tt))])
+    return lambda t: (np.interp(t, tt, aa), np.interp(t, tt, vv), np.interp(t, tt, xx))
 
 
 def harmonic_ground(w, amplitude):

@@ -1,7 +1,7 @@
 """scripts/building.py (tld_fmu.building) against the monolithic solution of the same coupled equations (issue:
 'a comparison with the monolithic solution of the same coupled equations for the linear case
 (error order vs communication step)'). With model = Linear (one mode) the building + dampers are
-one linear system, integrated here by scipy's DOP853 at rtol 1e-11:
+one linear system, integrated by scipy's DOP853 at rtol 1e-11 (building.monolithic):
 
     M_eff X'' + C X' + K X = -M_eff 1 a_g + sum_d e_d m_d (c_d x_d' + w_d^2 x_d)
     x_d'' + c_d x_d' + w_d^2 x_d = -(a_g + X_floor(d)'')
@@ -57,16 +57,6 @@ def test_cosimulation_converges_to_the_monolithic_solution(fmu_path, model_descr
     extra = np.zeros(len(b["masses"]))
     extra[floor] = inactive
     bld = building.Building(b["masses"], b["stiffnesses"], b["rayleigh"], extra)
-    n = bld.n
-    c_d = 2 * ZETA * w_d
-
-    def rhs(t, y):
-        X, V, x, v = y[:n], y[n:2 * n], y[2 * n], y[2 * n + 1]
-        F = np.zeros(n)
-        F[floor] = m_d * (c_d * v + w_d ** 2 * x)
-        ag = ground(t)[0]
-        A = bld.accel(X, V, F + wind(t), ag)
-        return np.concatenate([V, A, [v, -(ag + A[floor]) - c_d * v - w_d ** 2 * x]])
 
     dts = [4e-3, 2e-3, 1e-3]
     errors = []
@@ -74,9 +64,8 @@ def test_cosimulation_converges_to_the_monolithic_solution(fmu_path, model_descr
         forces = None if load == "ground" else np.array([wind(t) for t in np.arange(2 * int(round(T / dt)) + 1) * dt / 2])
         s = building.simulate(cfg, unzipdir, model_description, ground, dt, T, floor_forces=forces,
                               derivatives=derivatives)
-        ref = solve_ivp(rhs, (0, T), np.zeros(2 * n + 2), method="DOP853", rtol=1e-11, atol=1e-14,
-                        t_eval=s["t"])
-        roof = ref.y[n - 1]
+        roof = building.monolithic(bld, [(floor, m_d, w_d, ZETA)], ground, s["t"],
+                                   floor_forces=None if load == "ground" else wind)[:, -1]
         errors.append(np.max(np.abs(s["X"][:, -1] - roof)) / np.max(np.abs(roof)))
     ratios = [errors[i] / errors[i + 1] for i in range(2)]
     print(f"\nroof displacement vs monolithic ({'derivatives' if derivatives else 'held'}): errors "
