@@ -119,7 +119,7 @@ const fn call(name: &'static str, allowed: u8) -> Call {
     }
 }
 
-const CO_SIMULATION_ONLY: &str = "TLD.fmu is a Co-Simulation FMU; Model Exchange is not provided";
+const CO_SIMULATION_ONLY: &str = "this is a Co-Simulation FMU; Model Exchange is not provided";
 
 const fn never(name: &'static str, why: &'static str) -> Call {
     Call {
