@@ -1,14 +1,4 @@
-//! Building.fmu: a linear N-storey shear building (SYSTEM.md), advanced exactly over each
-//! communication step, as an FMI 2.0 Co-Simulation FMU, the reference structure for TLD.fmu.
-//!
-//! Layers, data flowing one way: `slave` (Building's side of the shared FMI layer, fmi2/:
-//! variables, parameters, the saved state) -> `structure` (the building's matrices, modes and
-//! Rayleigh damping) and `propagator` (the exact step of a linear system for polynomial inputs).
-//! Only `slave` knows FMI.
+//! Building.fmu's shared library: the fmi2* exports of the shared FMI layer for Building's
+//! slave (building-model, model/).
 
-pub mod description;
-pub mod propagator;
-pub mod slave;
-pub mod structure;
-
-fmi2_slave::export_fmi2!(slave::Building);
+fmi2_slave::export_fmi2!(building_model::Building);

@@ -6,8 +6,8 @@ use std::ffi::CString;
 use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};
 
-use building_fmu::description::GUID;
-pub use building_fmu::description::vr;
+use building_model::description::GUID;
+pub use building_model::description::vr;
 pub use fmi_sys::fmi2::*;
 
 pub const OK: fmi2Status = fmi2Status_fmi2OK;

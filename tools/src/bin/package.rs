@@ -36,13 +36,13 @@ const BUILDING: Fmu = Fmu {
     id: "Building",
     xml: include_str!(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../building/modelDescription/modelDescription.xml"
+        "/../building/model/modelDescription/modelDescription.xml"
     )),
     doc: include_str!(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../building/modelDescription/documentation.html"
+        "/../building/model/modelDescription/documentation.html"
     )),
-    variables: building_fmu::description::VARIABLES,
+    variables: building_model::description::VARIABLES,
 };
 
 /// The FMU an output file is for: its name is the modelIdentifier's.
