@@ -1,0 +1,235 @@
+"""Building.fmu (SYSTEM.md) through fmpy, against references computed here independently of
+its Rust code: the matrices and Rayleigh coefficients are rebuilt from the parameters with
+scipy, and
+
+- the exact step: whole histories under held and ramped (input derivatives) inputs against
+  scipy's DOP853 (rtol 1e-12) integrating the same piecewise input step by step, at a step so
+  large that any integration of the FMU's own would show;
+- a 1-storey harmonic steady state against its closed form, a 3-storey one against the complex
+  frequency response (modal superposition), after the transient has died out;
+- the declared modes and damping against scipy's generalised eigenproblem;
+- fmpy's validate_fmu (the compliance checkers run on both FMUs in test_compliance.py).
+"""
+from __future__ import annotations
+
+import shutil
+import tempfile
+
+import numpy as np
+import pytest
+import scipy.linalg
+from scipy.integrate import solve_ivp
+
+THREE = dict(masses=[60.0, 60.0, 50.0], stiffnesses=[9600.0, 8230.0, 6860.0], zeta=0.05,
+             tld_mass=0.35)
+
+
+@pytest.fixture(scope="module")
+def building(building_path):
+    from fmpy import extract, read_model_description
+    md = read_model_description(str(building_path))
+    d = tempfile.mkdtemp(prefix="building_fmu_")
+    extract(str(building_path), d)
+    yield md, d, {v.name: v.valueReference for v in md.modelVariables}
+    shutil.rmtree(d, ignore_errors=True)
+
+
+class Run:
+    """One initialised Building.fmu instance."""
+
+    def __init__(self, building, masses, stiffnesses, zeta, tld_mass=0.0, floor=0):
+        from fmpy.fmi2 import FMU2Slave
+        md, d, self.vr = building
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=d, modelIdentifier="Building",
+                             instanceName="building")
+        self.fmu.instantiate()
+        self.fmu.setupExperiment(startTime=0.0)
+        self.fmu.enterInitializationMode()
+        n = len(masses)
+        self.fmu.setInteger([self.vr["storeys"], self.vr["tld.floor"]], [n, floor])
+        names = [f"storey[{i + 1}].mass" for i in range(n)] + \
+                [f"storey[{i + 1}].stiffness" for i in range(n)] + ["damping.zeta", "tld.mass"]
+        self.fmu.setReal([self.vr[k] for k in names], list(masses) + list(stiffnesses) + [zeta, tld_mass])
+        self.fmu.exitInitializationMode()
+        self.n, self.t = n, 0.0
+
+    def get(self, *names):
+        return self.fmu.getReal([self.vr[k] for k in names])
+
+    def step(self, h, inputs, rates=None):
+        """inputs/rates: {name: value}; rates are order-1 input derivatives over the step."""
+        self.fmu.setReal([self.vr[k] for k in inputs], list(inputs.values()))
+        if rates:
+            names = list(rates)
+            self.fmu.setRealInputDerivatives([self.vr[k] for k in names], [1] * len(names),
+                                             list(rates.values()))
+        self.fmu.doStep(self.t, h)
+        self.t += h
+
+    def close(self):
+        self.fmu.terminate()
+        self.fmu.freeInstance()
+
+
+def matrices(masses, stiffnesses, zeta, tld_mass=0.0, floor=None):
+    """M, C, K and the circular frequencies, rebuilt here (scipy), Rayleigh at modes 1 and 2."""
+    n = len(masses)
+    m = np.array(masses, float)
+    m[(floor or n) - 1] += tld_mass
+    k = np.array(stiffnesses, float)
+    K = np.zeros((n, n))
+    for i in range(n):
+        K[i, i] = k[i] + (k[i + 1] if i + 1 < n else 0.0)
+        if i + 1 < n:
+            K[i, i + 1] = K[i + 1, i] = -k[i + 1]
+    M = np.diag(m)
+    w = np.sqrt(scipy.linalg.eigh(K, M, eigvals_only=True))
+    if n == 1:
+        alpha, beta = zeta * w[0], zeta / w[0]
+    else:
+        # zeta = alpha/(2 w) + beta w/2 at w1 and w2
+        alpha, beta = np.linalg.solve([[1 / (2 * w[0]), w[0] / 2], [1 / (2 * w[1]), w[1] / 2]],
+                                      [zeta, zeta])
+    return M, alpha * M + beta * K, K, w, (alpha, beta)
+
+
+def test_validate_fmu(building_path):
+    from fmpy.validation import validate_fmu
+    problems = validate_fmu(str(building_path))
+    assert problems == [], "\n".join(problems)
+
+
+def test_modes_and_rayleigh_coefficients(building):
+    M, C, K, w, (alpha, beta) = matrices(**THREE)
+    run = Run(building, **THREE)
+    got = run.get("mode[1].omega", "mode[2].omega", "damping.alpha", "damping.beta")
+    run.close()
+    np.testing.assert_allclose(got, [w[0], w[1], alpha, beta], rtol=1e-10)
+
+
+def reference_history(M, C, K, h, steps, ground, force, floor, ramp):
+    """z = [u, u', x_g, v_g] at every communication point by DOP853 (rtol 1e-12), each step
+    integrated on its own with the input the FMU gets: held at its value at the step's start,
+    or (ramp) its value plus its slope times the time into the step."""
+    n = len(M)
+    Minv = np.linalg.inv(M)
+    z = np.zeros(2 * n + 2)
+    out = [z.copy()]
+    for j in range(steps):
+        t0 = j * h
+
+        def inputs(s):
+            ag, fd = ground(t0), force(t0)
+            if ramp:
+                eps = 1e-7
+                ag += s * (ground(t0 + eps) - ground(t0 - eps)) / (2 * eps)
+                fd += s * (force(t0 + eps) - force(t0 - eps)) / (2 * eps)
+            return ag, fd
+
+        def rhs(s, y):
+            u, v = y[:n], y[n:2 * n]
+            ag, fd = inputs(s)
+            f = np.zeros(n)
+            f[floor - 1] = fd
+            acc = Minv @ (f - C @ v - K @ u) - ag
+            return np.concatenate([v, acc, [y[2 * n + 1], ag]])
+
+        sol = solve_ivp(rhs, (0.0, h), z, method="DOP853", rtol=1e-12, atol=1e-15)
+        assert sol.success
+        z = sol.y[:, -1]
+        out.append(z.copy())
+    return np.array(out)
+
+
+@pytest.mark.parametrize("ramp", [False, True], ids=["held", "ramped"])
+@pytest.mark.parametrize("storeys", [1, 3])
+def test_exact_step_against_dop853(building, storeys, ramp):
+    p = THREE if storeys == 3 else dict(masses=[168.0], stiffnesses=[5342.0], zeta=0.02, tld_mass=0.5)
+    M, C, K, w, _ = matrices(**p)
+    n, floor = len(M), len(M)
+    h = 0.5 * 2 * np.pi / w[-1]   # half the shortest period: far beyond any integrator's step
+    steps = 40
+    ground = lambda t: 0.7 * np.sin(3.1 * t) + 0.2 * np.cos(7.3 * t)
+    force = lambda t: 3.0 * np.sin(5.0 * t + 0.3)
+    ref = reference_history(M, C, K, h, steps, ground, force, floor, ramp)
+    run = Run(building, **p)
+    names = [f"floor[{i + 1}].x" for i in range(n)]
+    got = [run.get(*names) + run.get("tld.x")]
+    eps = 1e-7
+    for j in range(steps):
+        t = j * h
+        rates = None
+        if ramp:
+            rates = {"ground.a": (ground(t + eps) - ground(t - eps)) / (2 * eps),
+                     "tld.force": (force(t + eps) - force(t - eps)) / (2 * eps)}
+        run.step(h, {"ground.a": ground(t), "tld.force": force(t)}, rates)
+        got.append(run.get(*names) + run.get("tld.x"))
+    run.close()
+    got = np.array(got)
+    want = np.column_stack([ref[:, :n], ref[:, 2 * n] + ref[:, floor - 1]])
+    # each output against its own largest value (the absolute tld.x carries the ground's drift)
+    scale = np.abs(want).max(axis=0)
+    err = (np.abs(got - want).max(axis=0) / scale).max()
+    print(f"{storeys} storeys, {'ramped' if ramp else 'held'}: h = {h:.4f} s, "
+          f"largest error {err:.2e} of each output's largest value")
+    assert err < 1e-9
+
+
+def test_one_storey_harmonic_steady_state_is_the_closed_form(building):
+    m, k, zeta, A, wf = 168.0, 5342.0, 0.05, 0.3, 4.0
+    run = Run(building, [m], [k], zeta)
+    h, T = 0.002, 80.0
+    steps = int(T / h)
+    xs = []
+    for j in range(steps):
+        t = j * h
+        run.step(h, {"ground.a": A * np.sin(wf * t)},
+                 {"ground.a": A * wf * np.cos(wf * t)})
+        if run.t > T - 2 * np.pi / wf:
+            xs.append(run.get("floor[1].x")[0])
+    run.close()
+    # u'' + 2 zeta w u' + w^2 u = -A sin(wf t): amplitude A / sqrt((w^2 - wf^2)^2 + (2 zeta w wf)^2)
+    w = np.sqrt(k / m)
+    want = A / np.sqrt((w ** 2 - wf ** 2) ** 2 + (2 * zeta * w * wf) ** 2)
+    got = 0.5 * (max(xs) - min(xs))
+    assert abs(got - want) / want < 1e-4, (got, want)
+
+
+def test_three_storey_harmonic_steady_state_is_the_frequency_response(building):
+    M, C, K, w, _ = matrices(**THREE)
+    A, wf = 0.2, 0.95 * w[0]
+    run = Run(building, **THREE)
+    h, T = 0.002, 90.0
+    steps = int(T / h)
+    names = ["floor[1].x", "floor[2].x", "floor[3].x", "tld.a"]
+    rows = []
+    for j in range(steps):
+        t = j * h
+        run.step(h, {"ground.a": A * np.sin(wf * t)}, {"ground.a": A * wf * np.cos(wf * t)})
+        if run.t > T - 2 * np.pi / wf:
+            rows.append([run.t] + run.get(*names))
+    run.close()
+    rows = np.array(rows)
+    # complex amplitude U of u = Im(U e^{i wf t}): (K - wf^2 M + i wf C) U = -M 1 A
+    U = np.linalg.solve(K - wf ** 2 * M + 1j * wf * C, -M @ np.ones(3) * A)
+    t = rows[:, 0]
+    for i in range(3):
+        want = np.imag(U[i] * np.exp(1j * wf * t))
+        assert np.abs(rows[:, 1 + i] - want).max() < 1e-4 * np.abs(U[i]), i
+    # absolute roof acceleration: -wf^2 u_3 + a_g
+    want_a = np.imag((-wf ** 2 * U[2] + A) * np.exp(1j * wf * t))
+    assert np.abs(rows[:, 4] - want_a).max() < 1e-4 * np.abs(-wf ** 2 * U[2] + A)
+
+
+def test_bad_input_is_refused_and_the_instance_goes_on(building):
+    from fmpy.fmi1 import FMICallException
+    run = Run(building, **THREE)
+    run.step(0.01, {"ground.a": 0.1})
+    before = run.get("roof.x", "tld.a")
+    with pytest.raises(FMICallException):
+        run.fmu.setReal([run.vr["ground.a"]], [float("nan")])
+    with pytest.raises(FMICallException):
+        run.fmu.doStep(run.t, -0.01)
+    assert run.get("roof.x", "tld.a") == before
+    run.step(0.01, {"ground.a": 0.1})
+    run.close()
