@@ -121,7 +121,7 @@ impl Table {
     /// The position of the variable `r` if `value` may be set there in `phase`: of type `ty`, a
     /// parameter (a fixed one only before fmi2ExitInitializationMode) or an input, and an
     /// acceptable value for it.
-    #[inline(never)]
+    #[inline]
     pub fn settable(
         &self,
         phase: Phase,

@@ -226,18 +226,22 @@ impl<S: Slave> Instance<S> {
                 t + h
             )));
         }
-        let notice = self.slave.step(&self.context, t, h)?;
+        let noticed = self.slave.step(&self.context, t, h)?;
         self.context.time = t + h;
-        match notice {
-            None => Ok(Status::Ok),
-            Some(message) => Ok(self.warn(&message)),
+        if noticed {
+            return Ok(self.pass_notice());
         }
+        Ok(Status::Ok)
     }
 
+    /// The slave's notice of the step just carried out, to the host as a warning.
     #[cold]
     #[inline(never)]
-    fn warn(&self, message: &str) -> Status {
-        self.log(Status::Warning, log_category::LOG_STATUS_WARNING, message);
+    fn pass_notice(&mut self) -> Status {
+        let Some(message) = self.slave.notice(&self.context) else {
+            return Status::Ok;
+        };
+        self.log(Status::Warning, log_category::LOG_STATUS_WARNING, &message);
         Status::Warning
     }
 

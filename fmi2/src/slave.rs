@@ -38,8 +38,16 @@ pub trait Slave: Sized {
     fn initialise(&mut self, context: &Context) -> Result<Vec<String>, Refusal>;
 
     /// fmi2DoStep from `t` by `h` (both finite, `h` > 0, `t` the instance's time): all or
-    /// nothing. `Ok(Some(message))` is a step carried out with a warning.
-    fn step(&mut self, context: &Context, t: f64, h: f64) -> Result<Option<String>, Refusal>;
+    /// nothing. `Ok(true)`: carried out, with a notice for the host ([`Slave::notice`]). (A
+    /// flag, not the message: the result stays two words, returned in registers.)
+    fn step(&mut self, context: &Context, t: f64, h: f64) -> Result<bool, Refusal>;
+
+    /// The notice of the step just carried out (`context.time` is its end), logged as a
+    /// warning.
+    fn notice(&mut self, context: &Context) -> Option<String> {
+        let _ = context;
+        None
+    }
 
     /// fmi2Get{Real,Integer,Boolean}: values of `vrs` read as `ty`, converted by `to`.
     fn get<T>(

@@ -3,12 +3,21 @@
 //! makes of a set (type, causality, variability, range) are the shared layer's
 //! (`Table::settable`); what is TLD's own is where a value comes from (`params::source_of`).
 
+use fmi2_slave::calls::Phase;
 use fmi2_slave::{Context, Refusal, Reply, Status, refuse};
 
 use super::params::{Source, derived_value, free_real_input, output_of, source_of};
 use super::slave::{TABLE, Tld};
 use super::vars::{VARIABLES, VarType, finite, index_of, vr};
 use crate::model::Output;
+
+/// Who asks for a value that is no load: the instance's context and the calling function, one
+/// pointer (the out-of-line path then takes all its arguments in registers).
+#[derive(Clone, Copy)]
+struct Ask<'a> {
+    context: &'a Context,
+    function: &'a str,
+}
 
 impl Tld {
     /// The value of `r` read as `ty` if it is a load: a stored value, or an output a master
@@ -38,7 +47,7 @@ impl Tld {
         for (slot, &r) in out.iter_mut().zip(vrs) {
             let value = match self.loaded(r, ty) {
                 Some(v) => v,
-                None => self.value_in_full(context, r, ty, function)?,
+                None => self.value_in_full(r, ty, &Ask { context, function })?,
             };
             *slot = to(value);
         }
@@ -47,13 +56,8 @@ impl Tld {
 
     /// The value of `r` read as `ty` where it is no load, or why there is none.
     #[inline(never)]
-    fn value_in_full(
-        &self,
-        context: &Context,
-        r: u32,
-        ty: VarType,
-        function: &str,
-    ) -> Result<f64, Refusal> {
+    fn value_in_full(&self, r: u32, ty: VarType, ask: &Ask) -> Result<f64, Refusal> {
+        let Ask { context, function } = *ask;
         match source_of(r, ty) {
             Source::Stored(index) => Ok(self.values.at(index)),
             Source::Output(which) => match &self.sim {
@@ -151,8 +155,19 @@ impl Tld {
     ) -> Result<usize, Refusal> {
         match Self::free_input(r, value, ty) {
             Some(index) => Ok(index),
-            None => TABLE.settable(context.phase, r, value, ty, function),
+            None => Self::check_in_full(context.phase, r, value, ty, function),
         }
+    }
+
+    #[inline(never)]
+    fn check_in_full(
+        phase: Phase,
+        r: u32,
+        value: f64,
+        ty: VarType,
+        function: &str,
+    ) -> Result<usize, Refusal> {
+        TABLE.settable(phase, r, value, ty, function)
     }
 
     /// fmi2SetRealInputDerivatives: derivatives of Real inputs for the next step. base.a's are
@@ -209,7 +224,7 @@ impl Tld {
 mod tests {
     use super::*;
     use crate::fmi::vars::Causality;
-    use fmi2_slave::calls::{Phase, allow};
+    use fmi2_slave::calls::allow;
     use fmi2_slave::frame::Experiment;
 
     /// The quick case of `check_set` must agree with the full check: every variable in its table

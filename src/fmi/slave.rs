@@ -54,15 +54,6 @@ impl Tld {
         }
         provisional.as_ref().ok_or_else(|| refuse("no simulation"))
     }
-
-    /// The damper's notice of implausible motion, to the host as a warning once per run.
-    #[cold]
-    #[inline(never)]
-    fn notice(&mut self, time: f64) -> Option<String> {
-        let a = self.values.get(vr::BASE_A);
-        let notice = self.sim.as_mut()?.notice(a)?;
-        Some(format!("fmi2DoStep to t = {time}: {notice}"))
-    }
 }
 
 impl Slave for Tld {
@@ -95,7 +86,7 @@ impl Slave for Tld {
     }
 
     #[inline]
-    fn step(&mut self, _: &Context, t: f64, h: f64) -> Result<Option<String>, Refusal> {
+    fn step(&mut self, _: &Context, t: f64, h: f64) -> Result<bool, Refusal> {
         debug_assert!(finite(t) && h > 0.0);
         let inputs = self.values.inputs(self.a_derivatives);
         let sim = self
@@ -106,10 +97,7 @@ impl Slave for Tld {
             Ok(report) => {
                 // Input derivatives describe one communication step.
                 self.a_derivatives = [0.0; 2];
-                if report.implausible {
-                    return Ok(self.notice(t + h));
-                }
-                Ok(None)
+                Ok(report.implausible)
             }
             Err(e) => Err(step_failed(t, h, e)),
         }
@@ -156,6 +144,13 @@ impl Slave for Tld {
         put: impl FnMut(usize, f64),
     ) -> fmi2_slave::Reply {
         self.rates(context, vrs, orders, put)
+    }
+
+    /// The damper's notice of implausible motion, to the host as a warning once per run.
+    fn notice(&mut self, context: &Context) -> Option<String> {
+        let a = self.values.get(vr::BASE_A);
+        let notice = self.sim.as_mut()?.notice(a)?;
+        Some(format!("fmi2DoStep to t = {}: {notice}", context.time))
     }
 
     fn flag(&self) -> bool {

@@ -251,7 +251,7 @@ impl Slave for Building {
         Ok(Vec::new())
     }
 
-    fn step(&mut self, _: &Context, t: f64, h: f64) -> Result<Option<String>, Refusal> {
+    fn step(&mut self, _: &Context, t: f64, h: f64) -> Result<bool, Refusal> {
         let Some(mut s) = self.sim.take() else {
             return Err(refuse("fmi2DoStep: no simulation (not initialised)"));
         };
@@ -272,7 +272,7 @@ impl Slave for Building {
         self.sim = Some(s);
         // Input derivatives describe one communication step.
         self.derivatives.iter_mut().for_each(|d| *d = [0.0; ORDERS]);
-        Ok(None)
+        Ok(false)
     }
 
     fn get<T>(

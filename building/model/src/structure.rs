@@ -145,16 +145,12 @@ impl Building {
     }
 
     /// Base shear: the force of storey 1's spring and of the damping forces to the ground,
-    /// 1^T (K u + C u') (its derivative: `z` = [u', u''] in place of [u, u']).
+    /// 1^T (K u + C u') = k_1 u_1 + 1^T C u' (linear: its rate is this of u' and u'').
     pub fn base_shear(&self, u: &[f64], v: &[f64]) -> f64 {
-        let n = self.n;
-        let mut sum = self.storeys[0] * u[0];
-        for i in 0..n {
-            for j in 0..n {
-                sum += self.damping[(i, j)] * v[j];
-            }
-        }
-        sum
+        let damping: f64 = (0..self.n)
+            .map(|j| self.damping.column(j).sum() * v[j])
+            .sum();
+        self.storeys[0] * u[0] + damping
     }
 }
 
@@ -198,4 +194,103 @@ pub fn rayleigh(omega: &[f64], zeta: [f64; 2]) -> Result<(f64, f64), String> {
         ));
     }
     Ok((alpha, beta))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_storeys(zeta: [f64; 2]) -> Building {
+        Building::new(&Design {
+            masses: vec![2.0, 1.0],
+            stiffnesses: vec![300.0, 100.0],
+            zeta,
+            damper_floor: 2,
+            damper_mass: 0.5,
+        })
+        .expect("a valid design")
+    }
+
+    /// Two storeys: omega^2 are the roots of det(K - w^2 M) = 0, written out by hand.
+    #[test]
+    fn two_storey_frequencies_are_the_roots_of_the_characteristic_polynomial() {
+        let b = two_storeys([0.02, 0.02]);
+        let (m1, m2, k1, k2) = (2.0_f64, 1.5, 300.0, 100.0);
+        // m1 m2 w^4 - (m1 k2 + m2 (k1 + k2)) w^2 + k1 k2 = 0
+        let (qa, qb, qc) = (m1 * m2, -(m1 * k2 + m2 * (k1 + k2)), k1 * k2);
+        let disc = (qb * qb - 4.0 * qa * qc).sqrt();
+        let want = [(-qb - disc) / (2.0 * qa), (-qb + disc) / (2.0 * qa)].map(f64::sqrt);
+        for (w, want) in b.omega.iter().zip(want) {
+            assert!((w - want).abs() < 1e-12 * want, "{w} vs {want}");
+        }
+    }
+
+    /// Rayleigh damping gives each of the first two modes its ratio: phi^T C phi /
+    /// (2 w phi^T M phi) = zeta_i for the mode shapes phi.
+    #[test]
+    fn rayleigh_damping_gives_each_mode_its_ratio() {
+        let zeta = [0.02, 0.035];
+        let b = two_storeys(zeta);
+        let m = DMatrix::from_diagonal(&b.mass);
+        for (i, w) in b.omega.iter().enumerate() {
+            // (K - w^2 M) phi = 0 with phi = [1, x]: first row gives x.
+            let x = (b.stiffness[(0, 0)] - w * w * b.mass[0]) / -b.stiffness[(0, 1)];
+            let phi = DVector::from_vec(vec![1.0, x]);
+            let c = (phi.transpose() * &b.damping * &phi)[0];
+            let mm = (phi.transpose() * &m * &phi)[0];
+            let got = c / (2.0 * w * mm);
+            assert!((got - zeta[i]).abs() < 1e-12, "mode {}: {got}", i + 1);
+        }
+    }
+
+    /// The first-order system's acceleration rows are the absolute accelerations less a_g.
+    #[test]
+    fn state_space_agrees_with_the_accelerations() {
+        let b = two_storeys([0.02, 0.03]);
+        let (a, bm) = b.state_space();
+        let z = [0.01, -0.02, 0.3, 0.1, 0.5, -0.2];
+        let (ag, f) = (0.7, [3.0, -1.0]);
+        let p = DVector::from_vec(vec![ag, f[0], f[1]]);
+        let dz = &a * DVector::from_column_slice(&z) + &bm * &p;
+        let acc = b.accelerations(&z, &f);
+        for i in 0..2 {
+            assert!((dz[2 + i] - (acc[i] - ag)).abs() < 1e-12);
+            assert_eq!(dz[i], z[2 + i]);
+        }
+        assert_eq!((dz[4], dz[5]), (z[5], ag));
+    }
+
+    #[test]
+    fn designs_that_cannot_be_built_say_why() {
+        let bad = |d: Design| Building::new(&d).err().unwrap_or_default();
+        let good = Design {
+            masses: vec![1.0, 1.0],
+            stiffnesses: vec![10.0, 10.0],
+            zeta: [0.02, 0.02],
+            damper_floor: 2,
+            damper_mass: 0.0,
+        };
+        assert!(
+            bad(Design {
+                damper_floor: 3,
+                ..good.clone()
+            })
+            .contains("tld.floor = 3")
+        );
+        assert!(
+            bad(Design {
+                masses: vec![1.0, 0.0],
+                ..good.clone()
+            })
+            .contains("positive")
+        );
+        assert!(
+            bad(Design {
+                zeta: [0.01, 0.5],
+                ..good.clone()
+            })
+            .contains("negative coefficient")
+        );
+        assert!(Building::new(&good).is_ok());
+    }
 }
