@@ -12,7 +12,7 @@ REPO = Path(__file__).resolve().parents[2]
 MODEL_DESCRIPTION = REPO / "modelDescription" / "modelDescription.xml"
 # what scripts/package writes; TLD_FMU_PATH overrides it (to test or drive another build)
 FMU = Path(os.environ.get("TLD_FMU_PATH") or REPO / "target" / "fmu" / "TLD.fmu")
-# the reference structure (SYSTEM.md), packed by the same command
+# the reference structure for TLD.fmu, packed by the same command
 BUILDING_FMU = Path(os.environ.get("BUILDING_FMU_PATH") or REPO / "target" / "fmu" / "Building.fmu")
 
 

@@ -1,4 +1,4 @@
-"""Building.fmu (SYSTEM.md) through fmpy, against references computed here independently of
+"""Building.fmu (the reference structure for TLD.fmu) through fmpy, against references computed here independently of
 its Rust code: the matrices and Rayleigh coefficients are rebuilt from the parameters with
 scipy, and
 

@@ -1,4 +1,4 @@
-//! Building.fmu's model: a linear N-storey shear building (SYSTEM.md), advanced exactly over
+//! Building.fmu's model: a linear N-storey shear building, advanced exactly over
 //! each communication step, and its slave of the shared FMI layer. The exports live in the
 //! cdylib crate (building/), so that the packaging tool can link this crate beside TLD's.
 //!
