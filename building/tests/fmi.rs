@@ -44,8 +44,14 @@ fn calls_out_of_order_are_refused_with_the_way_out() {
     inst.time = 0.0;
     inst.initialise(&ONE_STOREY);
     assert_eq!(inst.do_step(0.01), OK);
-    // Model Exchange functions exist and refuse.
+    // Model Exchange functions exist and refuse, naming this FMU.
     assert_eq!(unsafe { inst.lib.fmi2SetTime(inst.c, 0.0) }, ERROR);
+    let said = inst.logs();
+    assert!(
+        said.iter()
+            .any(|m| m.contains("Building.fmu is a Co-Simulation FMU")),
+        "{said:?}"
+    );
 }
 
 /// Every bad value is refused with a message, and the instance is byte for byte as before.

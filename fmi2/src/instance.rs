@@ -96,7 +96,9 @@ impl<S: Slave> Instance<S> {
         if self.context.phase.bit() & call.allowed != 0 {
             Ok(())
         } else {
-            Err(refuse(self.context.phase.refusal(call)))
+            Err(refuse(
+                self.context.phase.refusal(call, S::TABLE.model_identifier),
+            ))
         }
     }
 
