@@ -193,10 +193,8 @@ impl Building {
         let relative: Vec<f64> = a.iter().map(|ai| ai - p[0]).collect();
         let mut dz = z[n..2 * n].to_vec();
         dz.extend_from_slice(&relative);
-        let jerk = || {
-            let inner: Vec<f64> = b.accelerations(&dz, &dp[1..]);
-            inner
-        };
+        // a' = M^-1 (F' - C u'' - K u'): the accelerations of [u', u''] under the force rates.
+        let jerk = || b.accelerations(&dz, &dp[1..]);
         match which {
             Output::TldA => jerk()[b.damper],
             Output::TldV => a[b.damper],
