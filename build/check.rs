@@ -5,18 +5,25 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use crate::model::{Description, EnumType, LogCategory, MODEL_IDENTIFIER, Var, fail, num};
+use crate::model::{Description, EnumType, LogCategory, Var, fail, num};
 
-/// Every check, in the order of the messages a broken document would give.
-pub fn all(md: &Description) {
+/// Every check, in the order of the messages a broken document would give; `identifier` is
+/// the modelIdentifier the package builds.
+pub fn all(md: &Description, identifier: &str) {
     let model_identifier = &md.model_identifier;
-    if model_identifier != MODEL_IDENTIFIER {
+    if model_identifier != identifier {
         fail(format!(
-            "CoSimulation modelIdentifier must be {MODEL_IDENTIFIER}, found '{model_identifier}'"
+            "CoSimulation modelIdentifier must be {identifier}, found '{model_identifier}'"
         ));
     }
     check(&md.vars, &md.enums, &md.outputs, &md.initial_unknowns);
     check_types(&md.enums, &md.log_categories);
+    // The shared FMI layer (fmi2/) logs under these names.
+    for required in ["logStatusError", "logStatusWarning", "logCalls"] {
+        if !md.log_categories.iter().any(|c| c.name == required) {
+            fail(format!("LogCategories must declare '{required}'"));
+        }
+    }
 }
 
 fn check(

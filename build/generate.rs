@@ -5,11 +5,11 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use crate::model::{Description, EnumType, LogCategory, MODEL_IDENTIFIER, Var, XML, fail, num};
+use crate::model::{Description, EnumType, LogCategory, Var, XML, fail, num};
 
 /// The whole generated file.
 pub fn all(md: &Description) -> String {
-    let mut code = generate(&md.vars, &md.enums, &md.guid);
+    let mut code = generate(&md.vars, &md.enums, &md.guid, &md.model_identifier);
     generate_enums(&mut code, &md.enums);
     generate_log_categories(&mut code, &md.log_categories);
     generate_limits(&mut code, &md.vars);
@@ -35,7 +35,12 @@ fn opt_f64(v: Option<f64>) -> String {
     }
 }
 
-fn generate(vars: &[Var], enums: &BTreeMap<String, EnumType>, guid: &str) -> String {
+fn generate(
+    vars: &[Var],
+    enums: &BTreeMap<String, EnumType>,
+    guid: &str,
+    model_identifier: &str,
+) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -44,7 +49,7 @@ fn generate(vars: &[Var], enums: &BTreeMap<String, EnumType>, guid: &str) -> Str
     let _ = writeln!(s, "pub const GUID: &str = {guid:?};");
     let _ = writeln!(
         s,
-        "pub const MODEL_IDENTIFIER: &str = {MODEL_IDENTIFIER:?};"
+        "pub const MODEL_IDENTIFIER: &str = {model_identifier:?};"
     );
     let _ = writeln!(s, "pub const VARIABLES: &[Variable] = &[");
     for v in vars {

@@ -7,7 +7,6 @@ use quick_xml::events::{BytesStart, Event};
 use std::collections::BTreeMap;
 
 pub const XML: &str = "modelDescription/modelDescription.xml";
-pub const MODEL_IDENTIFIER: &str = "TLD";
 
 #[derive(Debug, Default)]
 pub struct Var {

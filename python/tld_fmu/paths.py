@@ -12,6 +12,8 @@ REPO = Path(__file__).resolve().parents[2]
 MODEL_DESCRIPTION = REPO / "modelDescription" / "modelDescription.xml"
 # what scripts/package writes; TLD_FMU_PATH overrides it (to test or drive another build)
 FMU = Path(os.environ.get("TLD_FMU_PATH") or REPO / "target" / "fmu" / "TLD.fmu")
+# the reference structure for TLD.fmu, packed by the same command
+BUILDING_FMU = Path(os.environ.get("BUILDING_FMU_PATH") or REPO / "target" / "fmu" / "Building.fmu")
 
 
 def cargo_executable(name: str, release: bool = False) -> Path:

@@ -1,60 +1,28 @@
-//! Variable access of an instance: the one path of every typed getter and setter, and the
-//! input and output derivatives. Integer and Boolean values travel as f64 inside.
+//! Variable access of TLD.fmu: the one path of its typed getters and setters, and the input and
+//! output derivatives. Integer and Boolean values travel as f64 inside. The checks every FMU
+//! makes of a set (type, causality, variability, range) are the shared layer's
+//! (`Table::settable`); what is TLD's own is where a value comes from (`params::source_of`).
 
-use super::instance::Instance;
+use fmi2_slave::calls::Phase;
+use fmi2_slave::{Context, Refusal, Reply, Status, refuse};
+
 use super::params::{Source, derived_value, free_real_input, output_of, source_of};
-use super::status::{Refusal, Reply, Status, refuse};
-use super::vars::{Causality, VARIABLES, VarType, Variability, Variable, finite, index_of, vr};
+use super::slave::{TABLE, Tld};
+use super::vars::{VARIABLES, VarType, finite, index_of, vr};
 use crate::model::Output;
 
-use super::calls::Phase;
-
-/// The variable behind `vr`.
-fn variable(vr: u32, function: &str) -> Result<(usize, &'static Variable), Refusal> {
-    match index_of(vr).and_then(|i| VARIABLES.get(i).map(|v| (i, v))) {
-        Some(found) => Ok(found),
-        None => Err(unknown(vr, function)),
-    }
+/// Who asks for a value that is no load: the instance's context and the calling function, one
+/// pointer (the out-of-line path then takes all its arguments in registers).
+#[derive(Clone, Copy)]
+struct Ask<'a> {
+    context: &'a Context,
+    function: &'a str,
 }
 
-#[cold]
-fn unknown(vr: u32, function: &str) -> Refusal {
-    refuse(format!("{function}: unknown value reference {vr}"))
-}
-
-#[cold]
-fn wrong_type(vr: u32, var: &Variable, function: &str) -> Refusal {
-    refuse(format!(
-        "{function}: '{}' (value reference {vr}) is of type {:?}",
-        var.name, var.ty
-    ))
-}
-
-#[cold]
-fn no_value(vr: u32, function: &str) -> Refusal {
-    let name = index_of(vr).map_or("?", |i| VARIABLES[i].name);
-    refuse(format!("{function}: '{name}' has no value"))
-}
-
-/// The variable behind `vr`, if it is of the type `ty` the calling function handles
-/// (fmi2Get/SetInteger also serve Enumeration variables).
-fn typed_variable(
-    vr: u32,
-    ty: VarType,
-    function: &str,
-) -> Result<(usize, &'static Variable), Refusal> {
-    let (index, var) = variable(vr, function)?;
-    if var.accessed_as(ty) {
-        Ok((index, var))
-    } else {
-        Err(wrong_type(vr, var, function))
-    }
-}
-
-impl Instance {
+impl Tld {
     /// The value of `r` read as `ty` if it is a load: a stored value, or an output a master
     /// reads after every step of a running simulation. None for anything else, which
-    /// [`Instance::value_in_full`] answers out of line.
+    /// [`Tld::value_in_full`] answers out of line.
     #[inline(always)]
     fn loaded(&self, r: u32, ty: VarType) -> Option<f64> {
         match source_of(r, ty) {
@@ -66,8 +34,10 @@ impl Instance {
 
     /// Values of the variables `vrs` of type `ty` into `out`, converted by `to`. The instance's
     /// phase has been checked.
-    pub fn get<T>(
+    #[inline(always)]
+    pub(super) fn get_values<T>(
         &self,
+        context: &Context,
         vrs: &[u32],
         out: &mut [T],
         ty: VarType,
@@ -77,7 +47,7 @@ impl Instance {
         for (slot, &r) in out.iter_mut().zip(vrs) {
             let value = match self.loaded(r, ty) {
                 Some(v) => v,
-                None => self.value_in_full(r, ty, function)?,
+                None => self.value_in_full(r, ty, &Ask { context, function })?,
             };
             *slot = to(value);
         }
@@ -86,42 +56,51 @@ impl Instance {
 
     /// The value of `r` read as `ty` where it is no load, or why there is none.
     #[inline(never)]
-    fn value_in_full(&self, r: u32, ty: VarType, function: &str) -> Result<f64, Refusal> {
+    fn value_in_full(&self, r: u32, ty: VarType, ask: &Ask) -> Result<f64, Refusal> {
+        let Ask { context, function } = *ask;
         match source_of(r, ty) {
             Source::Stored(index) => Ok(self.values.at(index)),
             Source::Output(which) => match &self.sim {
                 Some(sim) => Ok(sim.output(which, &self.values.inputs(self.a_derivatives))),
-                None => self.output_before_init(which),
+                None => self.output_before_init(context, which),
             },
-            Source::Derived => self.derived(r, function),
-            Source::NoValue(_) => Err(no_value(r, function)),
-            Source::WrongType(index) => Err(wrong_type(r, &VARIABLES[index], function)),
-            Source::Unknown => Err(unknown(r, function)),
+            Source::Derived => self.derived(context, r, function),
+            Source::NoValue(_) => Err(TABLE.no_value(r, function)),
+            Source::WrongType(index) => Err(fmi2_slave::description::wrong_type(
+                r,
+                &VARIABLES[index],
+                function,
+            )),
+            Source::Unknown => Err(fmi2_slave::description::unknown(r, function)),
         }
     }
 
     /// An output before the simulation exists: from the simulation the values would start.
     #[cold]
     #[inline(never)]
-    fn output_before_init(&self, which: Output) -> Result<f64, Refusal> {
+    fn output_before_init(&self, context: &Context, which: Output) -> Result<f64, Refusal> {
         let inputs = self.values.inputs(self.a_derivatives);
         let mut provisional = None;
-        Ok(self.simulation(&mut provisional)?.output(which, &inputs))
+        Ok(self
+            .simulation(context, &mut provisional)?
+            .output(which, &inputs))
     }
 
     /// A calculated parameter.
     #[cold]
     #[inline(never)]
-    fn derived(&self, r: u32, function: &str) -> Result<f64, Refusal> {
+    fn derived(&self, context: &Context, r: u32, function: &str) -> Result<f64, Refusal> {
         let mut provisional = None;
-        let derived = self.simulation(&mut provisional)?.derived();
-        derived_value(r, &derived).ok_or_else(|| no_value(r, function))
+        let derived = self.simulation(context, &mut provisional)?.derived();
+        derived_value(r, &derived).ok_or_else(|| TABLE.no_value(r, function))
     }
 
     /// Set the variables `vrs` of type `ty` to `values`, converted by `from`: all are checked
     /// before any is changed. The instance's phase has been checked.
-    pub fn set<T: Copy>(
+    #[inline(always)]
+    pub(super) fn set_values<T: Copy>(
         &mut self,
+        context: &Context,
         vrs: &[u32],
         values: &[T],
         ty: VarType,
@@ -131,12 +110,12 @@ impl Instance {
         // One variable (an input per step, the usual call): checked and set in one pass.
         if let ([r], [v]) = (vrs, values) {
             let v = from(*v);
-            let index = self.check_set(*r, v, ty, function)?;
+            let index = Self::check_set(context, *r, v, ty, function)?;
             self.put(*r, index, v);
             return Ok(Status::Ok);
         }
         for (&r, &v) in vrs.iter().zip(values) {
-            self.check_set(r, from(v), ty, function)?;
+            Self::check_set(context, r, from(v), ty, function)?;
         }
         for (&r, &v) in vrs.iter().zip(values) {
             if let Some(index) = index_of(r) {
@@ -168,7 +147,7 @@ impl Instance {
     /// input without bounds (the per-step input) takes any finite value: one table look-up.
     #[inline(always)]
     pub(super) fn check_set(
-        &self,
+        context: &Context,
         r: u32,
         value: f64,
         ty: VarType,
@@ -176,65 +155,31 @@ impl Instance {
     ) -> Result<usize, Refusal> {
         match Self::free_input(r, value, ty) {
             Some(index) => Ok(index),
-            None => self.check_set_in_full(r, value, ty, function),
+            None => Self::check_in_full(context.phase, r, value, ty, function),
         }
     }
 
     #[inline(never)]
-    fn check_set_in_full(
-        &self,
+    fn check_in_full(
+        phase: Phase,
         r: u32,
         value: f64,
         ty: VarType,
         function: &str,
     ) -> Result<usize, Refusal> {
-        let (index, var) = typed_variable(r, ty, function)?;
-        match var.causality {
-            Causality::Parameter => {
-                let before_init =
-                    matches!(self.phase, Phase::Instantiated | Phase::InitializationMode);
-                if !before_init && var.variability != Variability::Tunable {
-                    return Err(refuse(format!(
-                        "{function}: '{}' is a fixed parameter and can only be set before fmi2ExitInitializationMode",
-                        var.name
-                    )));
-                }
-            }
-            Causality::Input => {}
-            _ => {
-                return Err(refuse(format!(
-                    "{function}: '{}' is computed by the FMU and cannot be set",
-                    var.name
-                )));
-            }
-        }
-        if let Some(reason) = var.reject(value) {
-            return Err(refuse(format!("{function}: {reason}")));
-        }
-        Ok(index)
+        TABLE.settable(phase, r, value, ty, function)
     }
 
     /// fmi2SetRealInputDerivatives: derivatives of Real inputs for the next step. base.a's are
     /// used (orders 1 and 2); those of base.v and base.x are accepted and not needed.
-    pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Reply {
-        const F: &str = "fmi2SetRealInputDerivatives";
+    pub(super) fn input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> Reply {
         for ((&r, &order), &value) in vrs.iter().zip(orders).zip(values) {
-            let (_, var) = variable(r, F)?;
-            if var.causality != Causality::Input || var.ty != VarType::Real {
-                return Err(refuse(format!("{F}: '{}' is not a Real input", var.name)));
-            }
-            if !(1..=2).contains(&order) {
-                return Err(refuse(format!(
-                    "{F}: order {order} for '{}' is not supported (1 or 2)",
-                    var.name
-                )));
-            }
-            if !value.is_finite() {
-                return Err(refuse(format!(
-                    "{F}: derivative {value} of '{}' must be finite",
-                    var.name
-                )));
-            }
+            TABLE.check_input_derivative(r, order, value, 2)?;
         }
         for ((&r, &order), &value) in vrs.iter().zip(orders).zip(values) {
             if r == vr::BASE_A {
@@ -245,8 +190,9 @@ impl Instance {
     }
 
     /// fmi2GetRealOutputDerivatives: exact first derivatives of outputs, handed to `put`.
-    pub fn output_derivatives(
+    pub(super) fn rates(
         &self,
+        _: &Context,
         vrs: &[u32],
         orders: &[i32],
         mut put: impl FnMut(usize, f64),
@@ -258,7 +204,7 @@ impl Instance {
             .ok_or_else(|| refuse(format!("{F}: not initialised")))?;
         let inputs = self.values.inputs(self.a_derivatives);
         for (k, (&r, &order)) in vrs.iter().zip(orders).enumerate() {
-            let (_, var) = variable(r, F)?;
+            let (_, var) = TABLE.variable(r, F)?;
             let Some(which) = output_of(r) else {
                 return Err(refuse(format!("{F}: '{}' is not an output", var.name)));
             };
@@ -277,15 +223,15 @@ impl Instance {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fmi::calls::allow;
-    use crate::fmi::logger::Logger;
+    use crate::fmi::vars::Causality;
+    use fmi2_slave::calls::allow;
+    use fmi2_slave::frame::Experiment;
 
     /// The quick case of `check_set` must agree with the full check: every variable in its table
     /// takes any finite value, at its own position, in every phase that allows sets, and refuses a
     /// non-finite one; and every Real input the full check would take that way is in it.
     #[test]
     fn free_real_inputs_are_what_the_full_check_accepts() {
-        let mut inst = Instance::new(c"t".into(), Logger::new(None, std::ptr::null_mut()), false);
         let mut listed = 0;
         for phase in [
             Phase::Instantiated,
@@ -293,10 +239,14 @@ mod tests {
             Phase::StepComplete,
         ] {
             assert_ne!(phase.bit() & allow::SET, 0);
-            inst.phase = phase;
+            let context = Context {
+                phase,
+                experiment: Experiment::default(),
+                time: 0.0,
+            };
             for var in VARIABLES {
                 let r = var.vr;
-                let full = |v: f64| inst.check_set_in_full(r, v, VarType::Real, "t").ok();
+                let full = |v: f64| TABLE.settable(phase, r, v, VarType::Real, "t").ok();
                 let any_finite = [f64::MAX, -f64::MAX, 0.0, 5e-324, -1.5e7]
                     .iter()
                     .all(|&v| full(v) == index_of(r));
@@ -307,7 +257,7 @@ mod tests {
                         assert!(any_finite, "{} in {phase:?}", var.name);
                         for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
                             assert_eq!(full(v), None, "{} = {v}", var.name);
-                            let quick = inst.check_set(r, v, VarType::Real, "t").ok();
+                            let quick = Tld::check_set(&context, r, v, VarType::Real, "t").ok();
                             assert_eq!(quick, None, "{} = {v}", var.name);
                         }
                     }

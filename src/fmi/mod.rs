@@ -1,18 +1,18 @@
-//! The only place that speaks FMI: exported fmi2* functions (thin, panic-safe, each checked
-//! against its phase mask first), the instance and its call sequence, variable access, the
-//! saved-state format and logging.
+//! TLD.fmu's side of the FMI layer: the slave the shared layer (`fmi2_slave`, fmi2/) drives,
+//! its variable access, its parameters and its part of the saved state. The fmi2* exports, the
+//! call-sequence table, logging and the state frame are the shared layer's; this module emits
+//! them for [`slave::Tld`].
 
 mod access;
-mod calls;
-mod exports;
 #[cfg(test)]
 mod generated_tests;
-mod instance;
-mod logger;
 mod params;
+mod slave;
 mod snapshot;
-mod status;
 
 /// The model description's table, where the FMI layer has always offered it.
 pub use crate::description as vars;
-pub use status::Status;
+pub use fmi2_slave::Status;
+pub use slave::Tld;
+
+fmi2_slave::export_fmi2!(slave::Tld);

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from tld_fmu.paths import BUILDING_FMU
 from tld_fmu.paths import FMU as FMU_PATH   # the build's output; TLD_FMU_PATH overrides it
 from tld_fmu.slave import Slave
 
@@ -31,6 +32,20 @@ def _require_fmu() -> Path:
 @pytest.fixture(scope="session")
 def fmu_path() -> Path:
     return _require_fmu()
+
+
+@pytest.fixture(scope="session")
+def building_path() -> Path:
+    if not BUILDING_FMU.is_file():
+        pytest.fail(f"Building.fmu not found at {BUILDING_FMU}: build it first (scripts/package)",
+                    pytrace=False)
+    return BUILDING_FMU
+
+
+@pytest.fixture(scope="session", params=["TLD", "Building"])
+def any_fmu(request) -> Path:
+    """Each FMU of the workspace in turn: the checks every FMU must pass."""
+    return _require_fmu() if request.param == "TLD" else request.getfixturevalue("building_path")
 
 
 @pytest.fixture(scope="session")

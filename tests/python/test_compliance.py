@@ -1,4 +1,4 @@
-"""FMI 2.0 compliance of the packed TLD.fmu, by checkers independent of fmpy.validate_fmu (which
+"""FMI 2.0 compliance of the packed TLD.fmu and Building.fmu (each test runs on both), by checkers independent of fmpy.validate_fmu (which
 has its own test in test_interface.py):
 
 - the modelDescription.xml packed inside TLD.fmu (not the source copy) against the FMI 2.0 XML
@@ -100,9 +100,9 @@ def fmi2_schema():
     return lxml_etree.XMLSchema(lxml_etree.parse(str(xsd)))
 
 
-def test_packed_model_description_passes_fmi2_schema(fmu_path, fmi2_schema):
-    errors = schema_errors(fmi2_schema, packed_model_description(fmu_path))
-    print(f"FMI 2.0 XSD (lxml) on {fmu_path}!/{MD_NAME}: "
+def test_packed_model_description_passes_fmi2_schema(any_fmu, fmi2_schema):
+    errors = schema_errors(fmi2_schema, packed_model_description(any_fmu))
+    print(f"FMI 2.0 XSD (lxml) on {any_fmu}!/{MD_NAME}: "
           + ("no errors" if not errors else f"{len(errors)} error(s)"))
     for e in errors:
         print("  " + e)
@@ -114,9 +114,9 @@ def test_packed_model_description_passes_fmi2_schema(fmu_path, fmi2_schema):
     (break_missing_guid, "attribute 'guid' is required"),
     (break_missing_value_reference, "attribute 'valueReference' is required"),
 ], ids=["unknown-attribute", "missing-guid", "missing-valueReference"])
-def test_fmi2_schema_rejects_broken_copies(fmu_path, fmi2_schema, breakage, expected):
+def test_fmi2_schema_rejects_broken_copies(any_fmu, fmi2_schema, breakage, expected):
     """The validator above is really active: the same schema rejects a broken copy."""
-    good = packed_model_description(fmu_path)
+    good = packed_model_description(any_fmu)
     errors = schema_errors(fmi2_schema, breakage(good))
     print("\n".join(errors))
     assert errors, f"{breakage.__name__}: the schema accepted a broken modelDescription.xml"
@@ -124,8 +124,8 @@ def test_fmi2_schema_rejects_broken_copies(fmu_path, fmi2_schema, breakage, expe
 
 
 # -- fmu-manipulation-toolbox's checker ------------------------------------------------------------
-def test_fmu_manipulation_toolbox_check(fmu_path):
-    code, out = run_fmutool_check(fmu_path)
+def test_fmu_manipulation_toolbox_check(any_fmu):
+    code, out = run_fmutool_check(any_fmu)
     print(out)
     errors = [line for line in out.splitlines() if line.startswith(("ERROR", "CRITICAL", "WARNING"))]
     assert code == 0 and not errors, (
@@ -135,11 +135,11 @@ def test_fmu_manipulation_toolbox_check(fmu_path):
     assert "No semantic error against the FMI-2 standard." in out, out
 
 
-def test_fmu_manipulation_toolbox_check_rejects_broken_fmu(fmu_path, tmp_path):
+def test_fmu_manipulation_toolbox_check_rejects_broken_fmu(any_fmu, tmp_path):
     """The checker is really active: a copy with a schema error and a semantic error fails."""
-    xml, unlisted = break_unlist_first_output(packed_model_description(fmu_path))
+    xml, unlisted = break_unlist_first_output(packed_model_description(any_fmu))
     xml = break_unknown_attribute(xml)
-    code, out = run_fmutool_check(repack(fmu_path, tmp_path / "broken.fmu", xml))
+    code, out = run_fmutool_check(repack(any_fmu, tmp_path / "broken.fmu", xml))
     print(out)
     assert code == 7, f"fmutool -check should exit with CHECK_FAILED (7), got {code}:\n{out}"
     assert "notAnFmiAttribute" in out, out                          # the XSD check

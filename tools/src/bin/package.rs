@@ -1,22 +1,63 @@
-//! Packs TLD.fmu: modelDescription.xml, binaries/linux64/TLD.so and documentation/index.html
-//! (prose from modelDescription/documentation.html, variable table from the generated table).
+//! Packs an FMU of the workspace, TLD.fmu or Building.fmu (chosen by the output's file name):
+//! modelDescription.xml, binaries/<platform>/<modelIdentifier>.so and documentation/index.html
+//! (prose from its modelDescription/documentation.html, variable table from the generated
+//! table).
 //!
 //! Usage: tld-package <output .fmu> <library> [<library> ...] (scripts/package)
 
 use std::io::Write;
 use std::path::Path;
 
-use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType, Variable};
+use tld_fmu::fmi::vars::{Causality, VarType, Variable};
 use zip::write::SimpleFileOptions;
 
-const XML: &str = include_str!(concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../modelDescription/modelDescription.xml"
-));
-const DOC: &str = include_str!(concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../modelDescription/documentation.html"
-));
+/// One FMU of the workspace: what goes into its archive.
+struct Fmu {
+    id: &'static str,
+    xml: &'static str,
+    doc: &'static str,
+    variables: &'static [Variable],
+}
+
+const TLD: Fmu = Fmu {
+    id: "TLD",
+    xml: include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../modelDescription/modelDescription.xml"
+    )),
+    doc: include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../modelDescription/documentation.html"
+    )),
+    variables: tld_fmu::fmi::vars::VARIABLES,
+};
+
+const BUILDING: Fmu = Fmu {
+    id: "Building",
+    xml: include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../building/model/modelDescription/modelDescription.xml"
+    )),
+    doc: include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../building/model/modelDescription/documentation.html"
+    )),
+    variables: building_model::description::VARIABLES,
+};
+
+/// The FMU an output file is for: its name is the modelIdentifier's.
+fn fmu_for(out: &Path) -> Result<&'static Fmu, String> {
+    let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+    [&TLD, &BUILDING]
+        .into_iter()
+        .find(|f| f.id == stem)
+        .ok_or_else(|| {
+            format!(
+                "{}: the FMU's name must be TLD.fmu or Building.fmu",
+                out.display()
+            )
+        })
+}
 
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
@@ -69,7 +110,7 @@ fn cells(v: &Variable) -> [String; COLUMNS.len()] {
 }
 
 /// The variables as an HTML table, with descriptions taken from the XML.
-fn variable_table() -> String {
+fn variable_table(variables: &[Variable]) -> String {
     let row = |tag: &str, cells: &[String]| {
         let cells: String = cells
             .iter()
@@ -78,16 +119,17 @@ fn variable_table() -> String {
         format!("<tr>{cells}</tr>\n")
     };
     let header = row("th", &COLUMNS.map(String::from));
-    let rows: String = VARIABLES.iter().map(|v| row("td", &cells(v))).collect();
+    let rows: String = variables.iter().map(|v| row("td", &cells(v))).collect();
     format!("<table>\n{header}{rows}</table>")
 }
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 3 {
-        eprintln!("usage: tld-package <TLD.fmu> <library> [<library> ...]");
+        eprintln!("usage: tld-package <TLD.fmu | Building.fmu> <library> [<library> ...]");
         eprintln!("  each library's file name says its platform: *.so -> binaries/linux64/TLD.so,");
         eprintln!("  *.dll -> binaries/win64/TLD.dll, *.dylib -> binaries/darwin64/TLD.dylib");
+        eprintln!("  (Building.so, ... for Building.fmu)");
         std::process::exit(2);
     }
     let libraries: Vec<&Path> = args[2..].iter().map(Path::new).collect();
@@ -98,11 +140,11 @@ fn main() {
 }
 
 /// Where a built library goes in the FMU (FMI 2.0 section 2.3), from its file name.
-fn platform_path(library: &Path) -> Result<&'static str, String> {
+fn platform_path(library: &Path, id: &str) -> Result<String, String> {
     match library.extension().and_then(|e| e.to_str()) {
-        Some("so") => Ok("binaries/linux64/TLD.so"),
-        Some("dll") => Ok("binaries/win64/TLD.dll"),
-        Some("dylib") => Ok("binaries/darwin64/TLD.dylib"),
+        Some("so") => Ok(format!("binaries/linux64/{id}.so")),
+        Some("dll") => Ok(format!("binaries/win64/{id}.dll")),
+        Some("dylib") => Ok(format!("binaries/darwin64/{id}.dylib")),
         _ => Err(format!("{}: not a .so, .dll or .dylib", library.display())),
     }
 }
@@ -111,22 +153,25 @@ fn pack(out: &Path, libraries: &[&Path]) -> Result<(), Box<dyn std::error::Error
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    let doc = DOC.replace("{{VARIABLES}}", &variable_table());
+    let fmu = fmu_for(out)?;
+    let doc = fmu
+        .doc
+        .replace("{{VARIABLES}}", &variable_table(fmu.variables));
     let file =
         std::fs::File::create(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     zip.start_file("modelDescription.xml", options)?;
-    zip.write_all(XML.as_bytes())?;
-    let mut placed: Vec<&str> = Vec::new();
+    zip.write_all(fmu.xml.as_bytes())?;
+    let mut placed: Vec<String> = Vec::new();
     for library in libraries {
-        let inside = platform_path(library)?;
+        let inside = platform_path(library, fmu.id)?;
         if placed.contains(&inside) {
             return Err(format!("two libraries for {inside}").into());
         }
         let binary = std::fs::read(library)
             .map_err(|e| format!("cannot read {}: {e}", library.display()))?;
-        zip.start_file(inside, options.unix_permissions(0o755))?;
+        zip.start_file(inside.as_str(), options.unix_permissions(0o755))?;
         zip.write_all(&binary)?;
         println!(
             "  {inside}: {} bytes from {}",
@@ -163,7 +208,8 @@ mod tests {
 
     #[test]
     fn every_row_fills_every_column_and_the_unit_column_holds_the_units() {
-        let html = variable_table();
+        const VARIABLES: &[Variable] = TLD.variables;
+        let html = variable_table(VARIABLES);
         let header = table(&html, "th");
         assert_eq!(header.len(), 1);
         let header = &header[0];
@@ -183,6 +229,19 @@ mod tests {
 
     #[test]
     fn the_documentation_gets_the_table() {
-        assert!(DOC.contains("{{VARIABLES}}"));
+        for fmu in [&TLD, &BUILDING] {
+            assert!(fmu.doc.contains("{{VARIABLES}}"), "{}", fmu.id);
+            assert!(fmu.xml.contains(&format!("modelIdentifier=\"{}\"", fmu.id)));
+        }
+    }
+
+    #[test]
+    fn the_output_name_chooses_the_fmu() {
+        assert_eq!(
+            fmu_for(Path::new("target/fmu/Building.fmu")).map(|f| f.id),
+            Ok("Building")
+        );
+        assert_eq!(fmu_for(Path::new("TLD.fmu")).map(|f| f.id), Ok("TLD"));
+        assert!(fmu_for(Path::new("Other.fmu")).is_err());
     }
 }

@@ -5,7 +5,7 @@
 use fmi_sys::fmi2::{fmi2CallbackLogger, fmi2ComponentEnvironment};
 use std::ffi::{CStr, CString};
 
-use super::status::Status;
+use crate::status::Status;
 
 #[derive(Clone, Copy, Debug)]
 pub struct Logger {

@@ -4,9 +4,10 @@
 use fmi_sys::fmi2::*;
 
 use super::{guard, host_ref, host_slice, host_slice_mut};
-use crate::fmi::calls::{self, Call};
-use crate::fmi::instance::Instance;
-use crate::fmi::status::{Refusal, Status, refuse};
+use crate::calls::{self, Call};
+use crate::instance::Instance;
+use crate::slave::Slave;
+use crate::status::{Refusal, Status, refuse};
 
 /// What an fmi2FMUstate points to: the instance's state in its serialised form (one code path
 /// for in-memory and serialised states), with a mark to recognise it.
@@ -15,13 +16,14 @@ struct StateBox {
     bytes: Vec<u8>,
 }
 
-const STATE_MAGIC: u64 = 0x544c_445f_5354_4154;
-
 /// The state behind a host's fmi2FMUstate, if it is one of ours.
-unsafe fn state_box<'a>(state: fmi2FMUstate, function: &str) -> Result<&'a mut StateBox, Refusal> {
+unsafe fn state_box<'a, S: Slave>(
+    state: fmi2FMUstate,
+    function: &str,
+) -> Result<&'a mut StateBox, Refusal> {
     let p = state as *mut StateBox;
     // SAFETY: non-null, aligned, and marked: a state this library allocated and did not free.
-    if !p.is_null() && p.is_aligned() && unsafe { (*p).magic } == STATE_MAGIC {
+    if !p.is_null() && p.is_aligned() && unsafe { (*p).magic } == state_mark::<S>() {
         Ok(unsafe { &mut *p })
     } else {
         Err(refuse(format!(
@@ -30,57 +32,62 @@ unsafe fn state_box<'a>(state: fmi2FMUstate, function: &str) -> Result<&'a mut S
     }
 }
 
-fn new_state(bytes: Vec<u8>) -> fmi2FMUstate {
+/// The mark of a state box of this slave: not its instances' mark.
+const fn state_mark<S: Slave>() -> u64 {
+    S::MARK ^ 0x0000_0000_5354_4154
+}
+
+fn new_state<S: Slave>(bytes: Vec<u8>) -> fmi2FMUstate {
     Box::into_raw(Box::new(StateBox {
-        magic: STATE_MAGIC,
+        magic: state_mark::<S>(),
         bytes,
     })) as fmi2FMUstate
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetFMUstate(
+#[inline(always)]
+pub unsafe fn fmi2GetFMUstate<S: Slave>(
     c: fmi2Component,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     const CALL: &Call = &calls::GET_FMU_STATE;
-    guard(c, CALL, |inst| {
+    guard::<S>(c, CALL, |inst| {
         // SAFETY: host output scalar.
         let out = unsafe { host_ref(FMUstate, CALL, "FMUstate")? };
         let bytes = inst.save();
         if out.is_null() {
-            *out = new_state(bytes);
+            *out = new_state::<S>(bytes);
         } else {
             // The host hands back a state to overwrite.
-            unsafe { state_box(*out, "fmi2GetFMUstate")? }.bytes = bytes;
+            unsafe { state_box::<S>(*out, "fmi2GetFMUstate")? }.bytes = bytes;
         }
         Ok(Status::Ok)
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
+#[inline(always)]
+pub unsafe fn fmi2SetFMUstate<S: Slave>(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
     const CALL: &Call = &calls::SET_FMU_STATE;
-    guard(c, CALL, |inst| {
+    guard::<S>(c, CALL, |inst| {
         // SAFETY: a host state pointer, recognised by its mark.
-        let state = unsafe { state_box(FMUstate, "fmi2SetFMUstate")? };
+        let state = unsafe { state_box::<S>(FMUstate, "fmi2SetFMUstate")? };
         inst.load(&state.bytes)
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2FreeFMUstate(
+#[inline(always)]
+pub unsafe fn fmi2FreeFMUstate<S: Slave>(
     c: fmi2Component,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     const CALL: &Call = &calls::FREE_FMU_STATE;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host in-out scalar.
         let slot = unsafe { host_ref(FMUstate, CALL, "FMUstate")? };
         if slot.is_null() {
             return Ok(Status::Ok);
         }
         // SAFETY: a state of ours: unmark, then take the box back exactly once.
-        let state = unsafe { state_box(*slot, "fmi2FreeFMUstate")? };
+        let state = unsafe { state_box::<S>(*slot, "fmi2FreeFMUstate")? };
         state.magic = 0;
         drop(unsafe { Box::from_raw(state as *mut StateBox) });
         *slot = std::ptr::null_mut();
@@ -88,18 +95,18 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+#[inline(always)]
+pub unsafe fn fmi2SerializedFMUstateSize<S: Slave>(
     c: fmi2Component,
     FMUstate: fmi2FMUstate,
     size: *mut usize,
 ) -> fmi2Status {
     const CALL: &Call = &calls::SERIALIZED_FMU_STATE_SIZE;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host state and output scalar.
         let (state, out) = unsafe {
             (
-                state_box(FMUstate, "fmi2SerializedFMUstateSize")?,
+                state_box::<S>(FMUstate, "fmi2SerializedFMUstateSize")?,
                 host_ref(size, CALL, "size")?,
             )
         };
@@ -108,17 +115,17 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SerializeFMUstate(
+#[inline(always)]
+pub unsafe fn fmi2SerializeFMUstate<S: Slave>(
     c: fmi2Component,
     FMUstate: fmi2FMUstate,
     serializedState: *mut fmi2Byte,
     size: usize,
 ) -> fmi2Status {
     const CALL: &Call = &calls::SERIALIZE_FMU_STATE;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host state pointer.
-        let state = unsafe { state_box(FMUstate, "fmi2SerializeFMUstate")? };
+        let state = unsafe { state_box::<S>(FMUstate, "fmi2SerializeFMUstate")? };
         if size != state.bytes.len() {
             return Err(refuse(format!(
                 "fmi2SerializeFMUstate: size {size} is not the serialised size {} (ask fmi2SerializedFMUstateSize)",
@@ -132,15 +139,15 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+#[inline(always)]
+pub unsafe fn fmi2DeSerializeFMUstate<S: Slave>(
     c: fmi2Component,
     serializedState: *const fmi2Byte,
     size: usize,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     const CALL: &Call = &calls::DE_SERIALIZE_FMU_STATE;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host buffer of `size` bytes and host output scalar.
         let (bytes, out) = unsafe {
             (
@@ -148,23 +155,15 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
                 host_ref(FMUstate, CALL, "FMUstate")?,
             )
         };
-        Instance::check_saved(bytes)
+        Instance::<S>::check_saved(bytes)
             .map_err(|r| refuse(format!("fmi2DeSerializeFMUstate: {}", r.message)))?;
         // A host may hand back one of our states for reuse (fmpy does); anything else in the
         // slot is not ours to free, and a new state is made.
         // SAFETY: a host state pointer, recognised by its mark.
-        match unsafe { state_box(*out, "fmi2DeSerializeFMUstate") } {
+        match unsafe { state_box::<S>(*out, "fmi2DeSerializeFMUstate") } {
             Ok(state) => state.bytes = bytes.to_vec(),
-            Err(_) => *out = new_state(bytes.to_vec()),
+            Err(_) => *out = new_state::<S>(bytes.to_vec()),
         }
         Ok(Status::Ok)
     })
 }
-
-// The signatures above must match the FMI 2.0 headers exactly.
-const _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
-const _: fmi2SetFMUstateTYPE = Some(fmi2SetFMUstate);
-const _: fmi2FreeFMUstateTYPE = Some(fmi2FreeFMUstate);
-const _: fmi2SerializedFMUstateSizeTYPE = Some(fmi2SerializedFMUstateSize);
-const _: fmi2SerializeFMUstateTYPE = Some(fmi2SerializeFMUstate);
-const _: fmi2DeSerializeFMUstateTYPE = Some(fmi2DeSerializeFMUstate);

@@ -7,24 +7,25 @@ use std::panic::catch_unwind;
 use fmi_sys::fmi2::*;
 
 use super::{guard, host_ref, host_slice, host_text};
-use crate::fmi::calls::{self, Call};
-use crate::fmi::instance::Instance;
-use crate::fmi::logger::Logger;
-use crate::fmi::status::{Refusal, Status, refuse};
-use crate::fmi::vars::{GUID, log_category};
+use crate::calls::{self, Call};
+use crate::description::log_category;
+use crate::instance::Instance;
+use crate::logger::Logger;
+use crate::slave::Slave;
+use crate::status::{Refusal, Status, refuse};
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
+#[inline(always)]
+pub unsafe fn fmi2GetTypesPlatform<S: Slave>() -> *const c_char {
     c"default".as_ptr()
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetVersion() -> *const c_char {
+#[inline(always)]
+pub unsafe fn fmi2GetVersion<S: Slave>() -> *const c_char {
     c"2.0".as_ptr()
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2Instantiate(
+#[inline(always)]
+pub unsafe fn fmi2Instantiate<S: Slave>(
     instanceName: fmi2String,
     fmuType: fmi2Type,
     fmuGUID: fmi2String,
@@ -51,58 +52,62 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 message,
             );
         };
+        let model = S::TABLE.model_identifier;
         let Some(name) = name else {
-            report("TLD", "fmi2Instantiate: instanceName is NULL");
+            report(model, "fmi2Instantiate: instanceName is NULL");
             return std::ptr::null_mut();
         };
         if fmuType != fmi2Type_fmi2CoSimulation {
             report(
                 &name,
-                "fmi2Instantiate: TLD.fmu supports Co-Simulation only (fmuType must be fmi2CoSimulation)",
+                &format!(
+                    "fmi2Instantiate: {model}.fmu supports Co-Simulation only (fmuType must be fmi2CoSimulation)"
+                ),
             );
             return std::ptr::null_mut();
         }
         // SAFETY: as above.
         match unsafe { host_text(fmuGUID) } {
-            Some(guid) if guid == GUID => {}
+            Some(guid) if guid == S::TABLE.guid => {}
             other => {
                 report(
                     &name,
                     &format!(
-                        "fmi2Instantiate: GUID {other:?} does not match this binary's {GUID}: wrong modelDescription.xml?"
+                        "fmi2Instantiate: GUID {other:?} does not match this binary's {}: wrong modelDescription.xml?",
+                        S::TABLE.guid
                     ),
                 );
                 return std::ptr::null_mut();
             }
         }
         let c_name = CString::new(name.replace('\0', " ")).unwrap_or_default();
-        let instance = Box::new(Instance::new(c_name, logger, loggingOn != 0));
+        let instance = Box::new(Instance::<S>::new(c_name, logger, loggingOn != 0));
         Box::into_raw(instance) as fmi2Component
     });
     made.unwrap_or(std::ptr::null_mut())
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
+#[inline(always)]
+pub unsafe fn fmi2FreeInstance<S: Slave>(c: fmi2Component) {
     let _ = catch_unwind(|| {
         // SAFETY: only a pointer carrying our mark is taken back; the mark is wiped first, so
         // freeing the same pointer twice is recognised as long as the memory is not reused.
-        if let Some(inst) = unsafe { Instance::from_ptr(c) } {
+        if let Some(inst) = unsafe { Instance::<S>::from_ptr(c) } {
             inst.unmark();
-            drop(unsafe { Box::from_raw(inst as *mut Instance) });
+            drop(unsafe { Box::from_raw(inst as *mut Instance<S>) });
         }
     });
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetDebugLogging(
+#[inline(always)]
+pub unsafe fn fmi2SetDebugLogging<S: Slave>(
     c: fmi2Component,
     loggingOn: fmi2Boolean,
     nCategories: usize,
     categories: *const fmi2String,
 ) -> fmi2Status {
     const CALL: &Call = &calls::SET_DEBUG_LOGGING;
-    guard(c, CALL, |inst| {
+    guard::<S>(c, CALL, |inst| {
         // SAFETY: host array of category strings.
         let raw = unsafe { host_slice(categories, nCategories, CALL, "categories")? };
         let mut names = Vec::with_capacity(raw.len());
@@ -116,8 +121,8 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetupExperiment(
+#[inline(always)]
+pub unsafe fn fmi2SetupExperiment<S: Slave>(
     c: fmi2Component,
     toleranceDefined: fmi2Boolean,
     tolerance: fmi2Real,
@@ -125,63 +130,63 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     stopTimeDefined: fmi2Boolean,
     stopTime: fmi2Real,
 ) -> fmi2Status {
-    guard(c, &calls::SETUP_EXPERIMENT, |inst| {
+    guard::<S>(c, &calls::SETUP_EXPERIMENT, |inst| {
         let tolerance = (toleranceDefined != 0).then_some(tolerance);
         let stop = (stopTimeDefined != 0).then_some(stopTime);
         inst.setup_experiment(tolerance, startTime, stop)
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
-    guard(c, &calls::ENTER_INITIALIZATION_MODE, |inst| {
+#[inline(always)]
+pub unsafe fn fmi2EnterInitializationMode<S: Slave>(c: fmi2Component) -> fmi2Status {
+    guard::<S>(c, &calls::ENTER_INITIALIZATION_MODE, |inst| {
         inst.enter_initialization_mode()
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
-    guard(c, &calls::EXIT_INITIALIZATION_MODE, |inst| {
+#[inline(always)]
+pub unsafe fn fmi2ExitInitializationMode<S: Slave>(c: fmi2Component) -> fmi2Status {
+    guard::<S>(c, &calls::EXIT_INITIALIZATION_MODE, |inst| {
         inst.exit_initialization_mode()
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
-    guard(c, &calls::TERMINATE, |inst| inst.terminate())
+#[inline(always)]
+pub unsafe fn fmi2Terminate<S: Slave>(c: fmi2Component) -> fmi2Status {
+    guard::<S>(c, &calls::TERMINATE, |inst| inst.terminate())
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
-    guard(c, &calls::RESET, |inst| inst.reset())
+#[inline(always)]
+pub unsafe fn fmi2Reset<S: Slave>(c: fmi2Component) -> fmi2Status {
+    guard::<S>(c, &calls::RESET, |inst| inst.reset())
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2DoStep(
+#[inline(always)]
+pub unsafe fn fmi2DoStep<S: Slave>(
     c: fmi2Component,
     currentCommunicationPoint: fmi2Real,
     communicationStepSize: fmi2Real,
     _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
 ) -> fmi2Status {
-    guard(c, &calls::DO_STEP, |inst| {
+    guard::<S>(c, &calls::DO_STEP, |inst| {
         inst.do_step(currentCommunicationPoint, communicationStepSize)
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
+#[inline(always)]
+pub unsafe fn fmi2CancelStep<S: Slave>(c: fmi2Component) -> fmi2Status {
     // Never allowed: the guard refuses it with the table's reason.
-    guard(c, &calls::CANCEL_STEP, |_| Ok(Status::Ok))
+    guard::<S>(c, &calls::CANCEL_STEP, |_| Ok(Status::Ok))
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetStatus(
+#[inline(always)]
+pub unsafe fn fmi2GetStatus<S: Slave>(
     c: fmi2Component,
     _s: fmi2StatusKind,
     value: *mut fmi2Status,
 ) -> fmi2Status {
     const CALL: &Call = &calls::GET_STATUS;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host output scalar.
         unsafe { host_ref(value, CALL, "value")? };
         Err(Refusal::new(
@@ -191,14 +196,14 @@ pub unsafe extern "C" fn fmi2GetStatus(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetRealStatus(
+#[inline(always)]
+pub unsafe fn fmi2GetRealStatus<S: Slave>(
     c: fmi2Component,
     s: fmi2StatusKind,
     value: *mut fmi2Real,
 ) -> fmi2Status {
     const CALL: &Call = &calls::GET_REAL_STATUS;
-    guard(c, CALL, |inst| {
+    guard::<S>(c, CALL, |inst| {
         // SAFETY: host output scalar.
         let out = unsafe { host_ref(value, CALL, "value")? };
         if s != fmi2StatusKind_fmi2LastSuccessfulTime {
@@ -214,14 +219,14 @@ pub unsafe extern "C" fn fmi2GetRealStatus(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetIntegerStatus(
+#[inline(always)]
+pub unsafe fn fmi2GetIntegerStatus<S: Slave>(
     c: fmi2Component,
     s: fmi2StatusKind,
     value: *mut fmi2Integer,
 ) -> fmi2Status {
     const CALL: &Call = &calls::GET_INTEGER_STATUS;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host output scalar.
         unsafe { host_ref(value, CALL, "value")? };
         Err(Refusal::new(
@@ -231,14 +236,14 @@ pub unsafe extern "C" fn fmi2GetIntegerStatus(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetBooleanStatus(
+#[inline(always)]
+pub unsafe fn fmi2GetBooleanStatus<S: Slave>(
     c: fmi2Component,
     s: fmi2StatusKind,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
     const CALL: &Call = &calls::GET_BOOLEAN_STATUS;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host output scalar.
         let out = unsafe { host_ref(value, CALL, "value")? };
         if s != fmi2StatusKind_fmi2Terminated {
@@ -255,14 +260,14 @@ pub unsafe extern "C" fn fmi2GetBooleanStatus(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetStringStatus(
+#[inline(always)]
+pub unsafe fn fmi2GetStringStatus<S: Slave>(
     c: fmi2Component,
     s: fmi2StatusKind,
     value: *mut fmi2String,
 ) -> fmi2Status {
     const CALL: &Call = &calls::GET_STRING_STATUS;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host output scalar.
         unsafe { host_ref(value, CALL, "value")? };
         Err(Refusal::new(
@@ -272,61 +277,9 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
     })
 }
 
-/// Functions this FMU exports so that every host resolves its symbols, but never carries out:
-/// the table gives them no phase, and the guard refuses them with the table's reason.
-macro_rules! not_offered {
-    ($( fn $name:ident ( $( $arg:ident : $ty:ty ),* ) = $call:expr ; )*) => {
-        $(
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn $name(c: fmi2Component $(, $arg: $ty)*) -> fmi2Status {
-                $( let _ = $arg; )*
-                guard(c, &$call, |_| Ok(Status::Ok))
-            }
-        )*
-    };
+/// A function this FMU exports so that every host resolves its symbols, but never carries out:
+/// the table gives it no phase, and the guard refuses it with the table's reason.
+#[inline(always)]
+pub unsafe fn not_offered<S: Slave>(c: fmi2Component, call: &'static Call) -> fmi2Status {
+    guard::<S>(c, call, |_| Ok(Status::Ok))
 }
-
-not_offered! {
-    fn fmi2EnterEventMode() = calls::ENTER_EVENT_MODE;
-    fn fmi2NewDiscreteStates(info: *mut fmi2EventInfo) = calls::NEW_DISCRETE_STATES;
-    fn fmi2EnterContinuousTimeMode() = calls::ENTER_CONTINUOUS_TIME_MODE;
-    fn fmi2CompletedIntegratorStep(no_set_prior: fmi2Boolean, enter_event: *mut fmi2Boolean, terminate: *mut fmi2Boolean) = calls::COMPLETED_INTEGRATOR_STEP;
-    fn fmi2SetTime(time: fmi2Real) = calls::SET_TIME;
-    fn fmi2SetContinuousStates(x: *const fmi2Real, nx: usize) = calls::SET_CONTINUOUS_STATES;
-    fn fmi2GetDerivatives(derivatives: *mut fmi2Real, nx: usize) = calls::GET_DERIVATIVES;
-    fn fmi2GetEventIndicators(indicators: *mut fmi2Real, ni: usize) = calls::GET_EVENT_INDICATORS;
-    fn fmi2GetContinuousStates(x: *mut fmi2Real, nx: usize) = calls::GET_CONTINUOUS_STATES;
-    fn fmi2GetNominalsOfContinuousStates(nominals: *mut fmi2Real, nx: usize) = calls::GET_NOMINALS_OF_CONTINUOUS_STATES;
-    fn fmi2GetDirectionalDerivative(unknowns: *const fmi2ValueReference, n_unknown: usize, knowns: *const fmi2ValueReference, n_known: usize, dv_known: *const fmi2Real, dv_unknown: *mut fmi2Real) = calls::GET_DIRECTIONAL_DERIVATIVE;
-}
-
-// The signatures above must match the FMI 2.0 headers exactly (checked at compile time against
-// fmi-sys's bindgen types).
-const _: fmi2GetTypesPlatformTYPE = Some(fmi2GetTypesPlatform);
-const _: fmi2GetVersionTYPE = Some(fmi2GetVersion);
-const _: fmi2SetDebugLoggingTYPE = Some(fmi2SetDebugLogging);
-const _: fmi2InstantiateTYPE = Some(fmi2Instantiate);
-const _: fmi2FreeInstanceTYPE = Some(fmi2FreeInstance);
-const _: fmi2SetupExperimentTYPE = Some(fmi2SetupExperiment);
-const _: fmi2EnterInitializationModeTYPE = Some(fmi2EnterInitializationMode);
-const _: fmi2ExitInitializationModeTYPE = Some(fmi2ExitInitializationMode);
-const _: fmi2TerminateTYPE = Some(fmi2Terminate);
-const _: fmi2ResetTYPE = Some(fmi2Reset);
-const _: fmi2DoStepTYPE = Some(fmi2DoStep);
-const _: fmi2CancelStepTYPE = Some(fmi2CancelStep);
-const _: fmi2GetStatusTYPE = Some(fmi2GetStatus);
-const _: fmi2GetRealStatusTYPE = Some(fmi2GetRealStatus);
-const _: fmi2GetIntegerStatusTYPE = Some(fmi2GetIntegerStatus);
-const _: fmi2GetBooleanStatusTYPE = Some(fmi2GetBooleanStatus);
-const _: fmi2GetStringStatusTYPE = Some(fmi2GetStringStatus);
-const _: fmi2GetDirectionalDerivativeTYPE = Some(fmi2GetDirectionalDerivative);
-const _: fmi2EnterEventModeTYPE = Some(fmi2EnterEventMode);
-const _: fmi2NewDiscreteStatesTYPE = Some(fmi2NewDiscreteStates);
-const _: fmi2EnterContinuousTimeModeTYPE = Some(fmi2EnterContinuousTimeMode);
-const _: fmi2CompletedIntegratorStepTYPE = Some(fmi2CompletedIntegratorStep);
-const _: fmi2SetTimeTYPE = Some(fmi2SetTime);
-const _: fmi2SetContinuousStatesTYPE = Some(fmi2SetContinuousStates);
-const _: fmi2GetDerivativesTYPE = Some(fmi2GetDerivatives);
-const _: fmi2GetEventIndicatorsTYPE = Some(fmi2GetEventIndicators);
-const _: fmi2GetContinuousStatesTYPE = Some(fmi2GetContinuousStates);
-const _: fmi2GetNominalsOfContinuousStatesTYPE = Some(fmi2GetNominalsOfContinuousStates);

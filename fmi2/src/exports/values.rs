@@ -4,10 +4,11 @@
 use fmi_sys::fmi2::*;
 
 use super::{guard, host_slice, host_slice_mut};
-use crate::fmi::calls::{self, Call};
-use crate::fmi::instance::Instance;
-use crate::fmi::status::{Reply, Status, refuse};
-use crate::fmi::vars::VarType;
+use crate::calls::{self, Call};
+use crate::description::VarType;
+use crate::instance::Instance;
+use crate::slave::Slave;
+use crate::status::{Reply, Status, refuse};
 
 /// How one FMI value type travels to and from the instance's f64 values.
 trait Access {
@@ -58,14 +59,14 @@ impl Access for Booleans {
 
 /// fmi2Get{Real,Integer,Boolean}.
 #[inline(always)]
-unsafe fn get<A: Access>(
+unsafe fn get<S: Slave, A: Access>(
     c: fmi2Component,
     call: &'static Call,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut A::Host,
 ) -> fmi2Status {
-    guard(c, call, |inst| {
+    guard::<S>(c, call, |inst| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, out) = unsafe {
             (
@@ -73,20 +74,21 @@ unsafe fn get<A: Access>(
                 host_slice_mut(value, nvr, call, "value")?,
             )
         };
-        inst.get(vrs, out, A::TYPE, call.name, A::to_host)
+        inst.slave
+            .get(&inst.context, vrs, out, A::TYPE, call.name, A::to_host)
     })
 }
 
 /// fmi2Set{Real,Integer,Boolean}.
 #[inline(always)]
-unsafe fn set<A: Access>(
+unsafe fn set<S: Slave, A: Access>(
     c: fmi2Component,
     call: &'static Call,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *const A::Host,
 ) -> fmi2Status {
-    guard(c, call, |inst| {
+    guard::<S>(c, call, |inst| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, values) = unsafe {
             (
@@ -94,74 +96,75 @@ unsafe fn set<A: Access>(
                 host_slice(value, nvr, call, "value")?,
             )
         };
-        inst.set(vrs, values, A::TYPE, call.name, A::from_host)
+        inst.slave
+            .set(&inst.context, vrs, values, A::TYPE, call.name, A::from_host)
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetReal(
+#[inline(always)]
+pub unsafe fn fmi2GetReal<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut fmi2Real,
 ) -> fmi2Status {
     // SAFETY: the host's arguments, checked before use.
-    unsafe { get::<Reals>(c, &calls::GET_REAL, vr, nvr, value) }
+    unsafe { get::<S, Reals>(c, &calls::GET_REAL, vr, nvr, value) }
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetInteger(
+#[inline(always)]
+pub unsafe fn fmi2GetInteger<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut fmi2Integer,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { get::<Integers>(c, &calls::GET_INTEGER, vr, nvr, value) }
+    unsafe { get::<S, Integers>(c, &calls::GET_INTEGER, vr, nvr, value) }
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetBoolean(
+#[inline(always)]
+pub unsafe fn fmi2GetBoolean<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { get::<Booleans>(c, &calls::GET_BOOLEAN, vr, nvr, value) }
+    unsafe { get::<S, Booleans>(c, &calls::GET_BOOLEAN, vr, nvr, value) }
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetReal(
+#[inline(always)]
+pub unsafe fn fmi2SetReal<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { set::<Reals>(c, &calls::SET_REAL, vr, nvr, value) }
+    unsafe { set::<S, Reals>(c, &calls::SET_REAL, vr, nvr, value) }
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetInteger(
+#[inline(always)]
+pub unsafe fn fmi2SetInteger<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *const fmi2Integer,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { set::<Integers>(c, &calls::SET_INTEGER, vr, nvr, value) }
+    unsafe { set::<S, Integers>(c, &calls::SET_INTEGER, vr, nvr, value) }
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetBoolean(
+#[inline(always)]
+pub unsafe fn fmi2SetBoolean<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *const fmi2Boolean,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { set::<Booleans>(c, &calls::SET_BOOLEAN, vr, nvr, value) }
+    unsafe { set::<S, Booleans>(c, &calls::SET_BOOLEAN, vr, nvr, value) }
 }
 
 /// This FMU has no String variables: any value reference is unknown.
@@ -175,15 +178,15 @@ fn no_strings(vrs: &[u32], call: &Call) -> Reply {
     }
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetString(
+#[inline(always)]
+pub unsafe fn fmi2GetString<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut fmi2String,
 ) -> fmi2Status {
     const CALL: &Call = &calls::GET_STRING;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host arrays of nvr elements.
         let vrs = unsafe {
             host_slice_mut(value, nvr, CALL, "value")?;
@@ -193,15 +196,15 @@ pub unsafe extern "C" fn fmi2GetString(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetString(
+#[inline(always)]
+pub unsafe fn fmi2SetString<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *const fmi2String,
 ) -> fmi2Status {
     const CALL: &Call = &calls::SET_STRING;
-    guard(c, CALL, |_| {
+    guard::<S>(c, CALL, |_| {
         // SAFETY: host arrays of nvr elements.
         let vrs = unsafe {
             host_slice(value, nvr, CALL, "value")?;
@@ -211,8 +214,8 @@ pub unsafe extern "C" fn fmi2SetString(
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+#[inline(always)]
+pub unsafe fn fmi2SetRealInputDerivatives<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
@@ -220,7 +223,7 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     value: *const fmi2Real,
 ) -> fmi2Status {
     const CALL: &Call = &calls::SET_REAL_INPUT_DERIVATIVES;
-    guard(c, CALL, |inst: &mut Instance| {
+    guard::<S>(c, CALL, |inst: &mut Instance<S>| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, orders, values) = unsafe {
             (
@@ -229,12 +232,12 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
                 host_slice(value, nvr, CALL, "value")?,
             )
         };
-        inst.set_input_derivatives(vrs, orders, values)
+        inst.slave.set_input_derivatives(vrs, orders, values)
     })
 }
 
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+#[inline(always)]
+pub unsafe fn fmi2GetRealOutputDerivatives<S: Slave>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
@@ -242,7 +245,7 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     value: *mut fmi2Real,
 ) -> fmi2Status {
     const CALL: &Call = &calls::GET_REAL_OUTPUT_DERIVATIVES;
-    guard(c, CALL, |inst| {
+    guard::<S>(c, CALL, |inst| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, orders, out) = unsafe {
             (
@@ -251,18 +254,7 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
                 host_slice_mut(value, nvr, CALL, "value")?,
             )
         };
-        inst.output_derivatives(vrs, orders, |k, v| out[k] = v)
+        inst.slave
+            .output_derivatives(&inst.context, vrs, orders, |k, v| out[k] = v)
     })
 }
-
-// The signatures above must match the FMI 2.0 headers exactly.
-const _: fmi2GetRealTYPE = Some(fmi2GetReal);
-const _: fmi2GetIntegerTYPE = Some(fmi2GetInteger);
-const _: fmi2GetBooleanTYPE = Some(fmi2GetBoolean);
-const _: fmi2GetStringTYPE = Some(fmi2GetString);
-const _: fmi2SetRealTYPE = Some(fmi2SetReal);
-const _: fmi2SetIntegerTYPE = Some(fmi2SetInteger);
-const _: fmi2SetBooleanTYPE = Some(fmi2SetBoolean);
-const _: fmi2SetStringTYPE = Some(fmi2SetString);
-const _: fmi2SetRealInputDerivativesTYPE = Some(fmi2SetRealInputDerivatives);
-const _: fmi2GetRealOutputDerivativesTYPE = Some(fmi2GetRealOutputDerivatives);

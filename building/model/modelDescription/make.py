@@ -1,0 +1,150 @@
+"""Writes modelDescription.xml, Building.fmu's single source of truth (the build script reads
+it), from the per-storey pattern below: 20 storeys of parameters, inputs and outputs are
+written once here instead of by hand. Run it after editing: python3 make.py"""
+from pathlib import Path
+
+N = 20
+GUID = "{6a3e1d52-8c0b-4f7e-9b1a-3d2f5c7e9a41}"
+# Table 2.1's structure (168 kg) tuned to the tank's 5.6389 rad/s as one storey.
+MASS, STIFFNESS = 168.0, 5342.0
+
+vars = []  # (name, vr, causality, variability, initial, type, attrs, description)
+
+
+def add(name, vr, causality, variability, ty, description, initial=None, **attrs):
+    vars.append((name, vr, causality, variability, initial, ty, attrs, description))
+    return len(vars)  # 1-based index
+
+
+P = dict(causality="parameter", variability="fixed", initial="exact")
+storeys = add("storeys", 0, ty="Integer", start=1, min=1, max=N,
+              description=f"N, the number of storeys (1..{N}); the variables of storeys above N are ignored", **P)
+zeta = add("damping.zeta", 1, ty="Real", unit="1", start=0.02, min=0, max=0.99,
+           description="damping ratio of modes 1 and 2 (Rayleigh damping), unless damping.zeta1/zeta2 are set", **P)
+zeta1 = add("damping.zeta1", 2, ty="Real", unit="1", start=-1, min=-1, max=0.99,
+            description="damping ratio of mode 1; -1 (default): damping.zeta", **P)
+zeta2 = add("damping.zeta2", 3, ty="Real", unit="1", start=-1, min=-1, max=0.99,
+            description="damping ratio of mode 2; -1 (default): damping.zeta", **P)
+tld_floor = add("tld.floor", 4, ty="Integer", start=0, min=0, max=N,
+                description="the floor carrying the damper (1..N); 0 (default): the roof, floor N", **P)
+tld_mass = add("tld.mass", 5, ty="Real", unit="kg", start=0, min=0, max=1e9,
+               description="mass moving rigidly with the damper's floor: TLD.fmu's mass.inactive", **P)
+masses = [add(f"storey[{i}].mass", 100 + i - 1, ty="Real", unit="kg", start=MASS, min=1e-6, max=1e12,
+              description=f"mass of floor {i}", **P) for i in range(1, N + 1)]
+stiffs = [add(f"storey[{i}].stiffness", 200 + i - 1, ty="Real", unit="N/m", start=STIFFNESS, min=1e-6, max=1e15,
+              description=f"lateral stiffness of storey {i} (between floor {i - 1} and floor {i}; floor 0 is the ground)", **P)
+          for i in range(1, N + 1)]
+I = dict(causality="input", variability="continuous")
+ground_a = add("ground.a", 20, ty="Real", unit="m/s2", start=0,
+               description="ground acceleration, +x", **I)
+tld_force = add("tld.force", 21, ty="Real", unit="N", start=0,
+                description="force of the damper on its floor, +x (TLD.fmu's force)", **I)
+floor_f = [add(f"floor[{i}].force", 300 + i - 1, ty="Real", unit="N", start=0,
+               description=f"external force on floor {i}, +x (wind)", **I) for i in range(1, N + 1)]
+O = dict(causality="output", variability="continuous", initial="calculated")
+tld_a = add("tld.a", 30, ty="Real", unit="m/s2",
+            description="absolute acceleration of the damper's floor (TLD.fmu's base.a); feeds through tld.force and the floor forces", **O)
+tld_v = add("tld.v", 31, ty="Real", unit="m/s",
+            description="absolute velocity of the damper's floor (TLD.fmu's base.v): ground velocity from ground.a from rest plus the floor's relative velocity", **O)
+tld_x = add("tld.x", 32, ty="Real", unit="m",
+            description="absolute displacement of the damper's floor (TLD.fmu's base.x), likewise", **O)
+roof_x = add("roof.x", 33, ty="Real", unit="m", description="displacement of floor N relative to the ground", **O)
+shear = add("base_shear", 34, ty="Real", unit="N",
+            description="force of storey 1 on the ground: k_1 u_1 plus the Rayleigh damping forces 1^T C u'", **O)
+floor_x = [add(f"floor[{i}].x", 400 + i - 1, ty="Real", unit="m",
+               description=f"displacement of floor {i} relative to the ground", **O) for i in range(1, N + 1)]
+floor_a = [add(f"floor[{i}].a", 500 + i - 1, ty="Real", unit="m/s2",
+               description=f"absolute acceleration of floor {i}; feeds through its own force and tld.force", **O)
+           for i in range(1, N + 1)]
+C = dict(causality="calculatedParameter", variability="fixed", initial="calculated")
+w1 = add("mode[1].omega", 40, ty="Real", unit="rad/s", description="circular frequency of mode 1", **C)
+w2 = add("mode[2].omega", 41, ty="Real", unit="rad/s",
+         description="circular frequency of mode 2 (one storey: mode 1's)", **C)
+alpha = add("damping.alpha", 42, ty="Real", unit="1/s", description="Rayleigh mass coefficient: C = alpha M + beta K", **C)
+beta = add("damping.beta", 43, ty="Real", unit="s", description="Rayleigh stiffness coefficient", **C)
+
+
+def deps(xs):
+    return " ".join(str(x) for x in sorted(xs))
+
+
+structure = [storeys, tld_floor, tld_mass] + masses
+everything = structure + stiffs + [zeta, zeta1, zeta2]
+forces = [tld_force] + floor_f
+outputs = []  # (index, output deps, initial deps)
+outputs.append((tld_a, forces, forces + structure))
+for k in [tld_v, tld_x, roof_x, shear] + floor_x:
+    outputs.append((k, [], []))
+for i, k in enumerate(floor_a):
+    outputs.append((k, [tld_force, floor_f[i]], [tld_force, floor_f[i]] + structure))
+outputs.sort()
+initial = sorted(outputs + [(k, None, everything) for k in [w1, w2, alpha, beta]])
+
+
+def attr_text(attrs):
+    return " ".join(f'{k}="{v}"' for k, v in attrs.items())
+
+
+lines = ['<?xml version="1.0" encoding="UTF-8"?>',
+         "<!-- The single source of truth for Building.fmu's variables, written by make.py (edit that,",
+         "     then run it). The build script (build/) checks it and generates the Rust value-reference",
+         "     table (building/src/description.rs). -->",
+         f'''<fmiModelDescription
+  fmiVersion="2.0"
+  modelName="Building"
+  guid="{GUID}"
+  description="Linear N-storey shear building with Rayleigh damping, advanced exactly over each communication step (matrix exponential) for inputs held or polynomial over the step: the reference structure for TLD.fmu."
+  author="tld-fmu developers"
+  version="0.1.0"
+  generationTool="tld-fmu (Rust)"
+  variableNamingConvention="structured"
+  numberOfEventIndicators="0">
+
+  <CoSimulation
+    modelIdentifier="Building"
+    needsExecutionTool="false"
+    canHandleVariableCommunicationStepSize="true"
+    canInterpolateInputs="true"
+    maxOutputDerivativeOrder="1"
+    canRunAsynchronuously="false"
+    canBeInstantiatedOnlyOncePerProcess="false"
+    canNotUseMemoryManagementFunctions="true"
+    canGetAndSetFMUstate="true"
+    canSerializeFMUstate="true"
+    providesDirectionalDerivative="false"/>
+
+  <UnitDefinitions>
+    <Unit name="1"/>
+    <Unit name="m"><BaseUnit m="1"/></Unit>
+    <Unit name="m/s"><BaseUnit m="1" s="-1"/></Unit>
+    <Unit name="m/s2"><BaseUnit m="1" s="-2"/></Unit>
+    <Unit name="kg"><BaseUnit kg="1"/></Unit>
+    <Unit name="s"><BaseUnit s="1"/></Unit>
+    <Unit name="1/s"><BaseUnit s="-1"/></Unit>
+    <Unit name="rad/s"><BaseUnit s="-1" rad="1"/></Unit>
+    <Unit name="N"><BaseUnit kg="1" m="1" s="-2"/></Unit>
+    <Unit name="N/m"><BaseUnit kg="1" s="-2"/></Unit>
+  </UnitDefinitions>
+
+  <LogCategories>
+    <Category name="logStatusError" description="Errors: illegal calls, bad values, failed steps"/>
+    <Category name="logStatusWarning" description="Warnings"/>
+    <Category name="logCalls" description="Every FMI call"/>
+  </LogCategories>
+
+  <DefaultExperiment startTime="0" stopTime="60" stepSize="0.01"/>
+
+  <ModelVariables>''']
+for k, (name, vr, causality, variability, initial_, ty, attrs, description) in enumerate(vars, 1):
+    init = f' initial="{initial_}"' if initial_ else ""
+    lines.append(f'    <!-- {k} --><ScalarVariable name="{name}" valueReference="{vr}" causality="{causality}" '
+                 f'variability="{variability}"{init} description="{description}">')
+    lines.append(f"      <{ty} {attr_text(attrs)}/></ScalarVariable>".replace(f"<{ty} />", f"<{ty}/>"))
+lines.append("  </ModelVariables>\n\n  <ModelStructure>\n    <Outputs>")
+for k, d, _ in outputs:
+    lines.append(f'      <Unknown index="{k}" dependencies="{deps(d)}"/>')
+lines.append("    </Outputs>\n    <InitialUnknowns>")
+for k, _, d in initial:
+    lines.append(f'      <Unknown index="{k}" dependencies="{deps(d)}"/>')
+lines.append("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n")
+Path(__file__).with_name("modelDescription.xml").write_text("\n".join(lines))

@@ -1,0 +1,296 @@
+//! The linear shear building: storey masses and stiffnesses, the damper's inactive mass on its
+//! floor, Rayleigh damping fixed at the first two modes, and its first-order form. Nothing here
+//! knows FMI.
+//!
+//! Displacements `u` are relative to the ground; the equation of motion, with `a_g` the ground
+//! acceleration and `F` the floor forces (wind, the damper's force on its floor):
+//!
+//! ```text
+//! M u'' + C u' + K u = F - M 1 a_g,      absolute accelerations  a = u'' + 1 a_g = M^-1 (F - C u' - K u)
+//! ```
+//! K is tridiagonal (storey i joins floor i-1 to floor i, floor 0 being the ground) and
+//! C = alpha M + beta K with zeta_i = alpha / (2 omega_i) + beta omega_i / 2 at modes 1 and 2.
+//! The state adds the ground's velocity and displacement (x_g' = v_g, v_g' = a_g) so that the
+//! damper's floor can report its absolute motion.
+
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+
+/// Most storeys a building may have.
+pub const MAX_STOREYS: usize = 20;
+
+/// What a building is made of.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Design {
+    /// Floor masses, ground up (kg).
+    pub masses: Vec<f64>,
+    /// Storey stiffnesses, ground up (N/m): storey i joins floor i-1 (0: ground) and floor i.
+    pub stiffnesses: Vec<f64>,
+    /// Damping ratios of modes 1 and 2.
+    pub zeta: [f64; 2],
+    /// The floor carrying the damper, 1-based.
+    pub damper_floor: usize,
+    /// The damper's mass moving rigidly with its floor (TLD.fmu's mass.inactive, kg).
+    pub damper_mass: f64,
+}
+
+/// A configured building: its matrices, modes and damping.
+#[derive(Clone, Debug)]
+pub struct Building {
+    pub n: usize,
+    /// Floor masses with the damper's inactive mass added to its floor.
+    pub mass: DVector<f64>,
+    pub stiffness: DMatrix<f64>,
+    pub damping: DMatrix<f64>,
+    /// The storey stiffnesses as given (storey 1 is the base shear's spring).
+    pub storeys: Vec<f64>,
+    /// Circular frequencies of all modes, ascending (rad/s).
+    pub omega: Vec<f64>,
+    /// Rayleigh coefficients: C = alpha M + beta K.
+    pub alpha: f64,
+    pub beta: f64,
+    /// 0-based index of the damper's floor.
+    pub damper: usize,
+}
+
+impl Building {
+    pub fn new(d: &Design) -> Result<Self, String> {
+        let n = d.masses.len();
+        if n == 0 || n > MAX_STOREYS || d.stiffnesses.len() != n {
+            return Err(format!(
+                "{n} storeys: 1 to {MAX_STOREYS}, with a mass and a stiffness each"
+            ));
+        }
+        if !(1..=n).contains(&d.damper_floor) {
+            return Err(format!(
+                "tld.floor = {} is not a floor of the {n}-storey building (1..{n})",
+                d.damper_floor
+            ));
+        }
+        let positive = |x: &f64| x.is_finite() && *x > 0.0;
+        if !d.masses.iter().all(positive) || !d.stiffnesses.iter().all(positive) {
+            return Err("storey masses and stiffnesses must be positive and finite".into());
+        }
+        if !(d.damper_mass.is_finite() && d.damper_mass >= 0.0) {
+            return Err(format!("tld.mass = {} must be >= 0", d.damper_mass));
+        }
+        let mut mass = DVector::from_column_slice(&d.masses);
+        mass[d.damper_floor - 1] += d.damper_mass;
+        let k = &d.stiffnesses;
+        let stiffness = DMatrix::from_fn(n, n, |i, j| {
+            let above = if i + 1 < n { k[i + 1] } else { 0.0 };
+            match (i, j) {
+                _ if i == j => k[i] + above,
+                _ if j == i + 1 => -k[j],
+                _ if i == j + 1 => -k[i],
+                _ => 0.0,
+            }
+        });
+        let omega = frequencies(&mass, &stiffness);
+        let (alpha, beta) = rayleigh(&omega, d.zeta)?;
+        let damping = DMatrix::from_diagonal(&mass) * alpha + &stiffness * beta;
+        Ok(Building {
+            n,
+            mass,
+            stiffness,
+            damping,
+            storeys: d.stiffnesses.clone(),
+            omega,
+            alpha,
+            beta,
+            damper: d.damper_floor - 1,
+        })
+    }
+
+    /// Dimension of the first-order state [u, u', x_g, v_g].
+    pub fn states(&self) -> usize {
+        2 * self.n + 2
+    }
+
+    /// Number of input channels [a_g, F_1..F_n].
+    pub fn channels(&self) -> usize {
+        self.n + 1
+    }
+
+    /// The first-order system z' = A z + B p with z = [u, u', x_g, v_g], p = [a_g, F].
+    pub fn state_space(&self) -> (DMatrix<f64>, DMatrix<f64>) {
+        let n = self.n;
+        let (s, m) = (self.states(), self.channels());
+        let mut a = DMatrix::zeros(s, s);
+        let mut b = DMatrix::zeros(s, m);
+        for i in 0..n {
+            a[(i, n + i)] = 1.0;
+            for j in 0..n {
+                a[(n + i, j)] = -self.stiffness[(i, j)] / self.mass[i];
+                a[(n + i, n + j)] = -self.damping[(i, j)] / self.mass[i];
+            }
+            b[(n + i, 0)] = -1.0;
+            b[(n + i, 1 + i)] = 1.0 / self.mass[i];
+        }
+        a[(2 * n, 2 * n + 1)] = 1.0;
+        b[(2 * n + 1, 0)] = 1.0;
+        (a, b)
+    }
+
+    /// Absolute floor accelerations M^-1 (F - C u' - K u) for the state `z` and floor forces `f`.
+    pub fn accelerations(&self, z: &[f64], f: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        (0..n)
+            .map(|i| {
+                let inner: f64 = (0..n)
+                    .map(|j| self.damping[(i, j)] * z[n + j] + self.stiffness[(i, j)] * z[j])
+                    .sum();
+                (f[i] - inner) / self.mass[i]
+            })
+            .collect()
+    }
+
+    /// Base shear: the force of storey 1's spring and of the damping forces to the ground,
+    /// 1^T (K u + C u') = k_1 u_1 + 1^T C u' (linear: its rate is this of u' and u'').
+    pub fn base_shear(&self, u: &[f64], v: &[f64]) -> f64 {
+        let damping: f64 = (0..self.n)
+            .map(|j| self.damping.column(j).sum() * v[j])
+            .sum();
+        self.storeys[0] * u[0] + damping
+    }
+}
+
+/// Circular frequencies of K phi = omega^2 M phi, ascending: the eigenvalues of the symmetric
+/// M^-1/2 K M^-1/2.
+fn frequencies(mass: &DVector<f64>, stiffness: &DMatrix<f64>) -> Vec<f64> {
+    let n = mass.len();
+    let scaled = DMatrix::from_fn(n, n, |i, j| stiffness[(i, j)] / (mass[i] * mass[j]).sqrt());
+    let mut w: Vec<f64> = SymmetricEigen::new(scaled)
+        .eigenvalues
+        .iter()
+        .map(|l| l.max(0.0).sqrt())
+        .collect();
+    w.sort_by(f64::total_cmp);
+    w
+}
+
+/// Rayleigh coefficients (alpha, beta) giving damping ratios `zeta` at the first two modes; a
+/// one-storey building has one mode, damped by zeta[0] half through its mass and half through
+/// its stiffness.
+pub fn rayleigh(omega: &[f64], zeta: [f64; 2]) -> Result<(f64, f64), String> {
+    let [z1, z2] = zeta;
+    let (alpha, beta) = match omega {
+        [w] => (z1 * w, z1 / w),
+        [w1, w2, ..] => {
+            let d = w2 * w2 - w1 * w1;
+            (
+                2.0 * w1 * w2 * (z1 * w2 - z2 * w1) / d,
+                2.0 * (z2 * w2 - z1 * w1) / d,
+            )
+        }
+        [] => return Err("no storeys".into()),
+    };
+    if !(alpha >= 0.0 && beta >= 0.0 && alpha.is_finite() && beta.is_finite()) {
+        return Err(format!(
+            "Rayleigh damping with zeta1 = {z1} and zeta2 = {z2} at {:.4} and {:.4} rad/s would \
+             need a negative coefficient (alpha = {alpha:.4e}, beta = {beta:.4e}): higher modes \
+             would be undamped or excited; choose zeta2/zeta1 between omega1/omega2 and omega2/omega1",
+            omega[0],
+            omega.get(1).copied().unwrap_or(omega[0])
+        ));
+    }
+    Ok((alpha, beta))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_storeys(zeta: [f64; 2]) -> Building {
+        Building::new(&Design {
+            masses: vec![2.0, 1.0],
+            stiffnesses: vec![300.0, 100.0],
+            zeta,
+            damper_floor: 2,
+            damper_mass: 0.5,
+        })
+        .expect("a valid design")
+    }
+
+    /// Two storeys: omega^2 are the roots of det(K - w^2 M) = 0, written out by hand.
+    #[test]
+    fn two_storey_frequencies_are_the_roots_of_the_characteristic_polynomial() {
+        let b = two_storeys([0.02, 0.02]);
+        let (m1, m2, k1, k2) = (2.0_f64, 1.5, 300.0, 100.0);
+        // m1 m2 w^4 - (m1 k2 + m2 (k1 + k2)) w^2 + k1 k2 = 0
+        let (qa, qb, qc) = (m1 * m2, -(m1 * k2 + m2 * (k1 + k2)), k1 * k2);
+        let disc = (qb * qb - 4.0 * qa * qc).sqrt();
+        let want = [(-qb - disc) / (2.0 * qa), (-qb + disc) / (2.0 * qa)].map(f64::sqrt);
+        for (w, want) in b.omega.iter().zip(want) {
+            assert!((w - want).abs() < 1e-12 * want, "{w} vs {want}");
+        }
+    }
+
+    /// Rayleigh damping gives each of the first two modes its ratio: phi^T C phi /
+    /// (2 w phi^T M phi) = zeta_i for the mode shapes phi.
+    #[test]
+    fn rayleigh_damping_gives_each_mode_its_ratio() {
+        let zeta = [0.02, 0.035];
+        let b = two_storeys(zeta);
+        let m = DMatrix::from_diagonal(&b.mass);
+        for (i, w) in b.omega.iter().enumerate() {
+            // (K - w^2 M) phi = 0 with phi = [1, x]: first row gives x.
+            let x = (b.stiffness[(0, 0)] - w * w * b.mass[0]) / -b.stiffness[(0, 1)];
+            let phi = DVector::from_vec(vec![1.0, x]);
+            let c = (phi.transpose() * &b.damping * &phi)[0];
+            let mm = (phi.transpose() * &m * &phi)[0];
+            let got = c / (2.0 * w * mm);
+            assert!((got - zeta[i]).abs() < 1e-12, "mode {}: {got}", i + 1);
+        }
+    }
+
+    /// The first-order system's acceleration rows are the absolute accelerations less a_g.
+    #[test]
+    fn state_space_agrees_with_the_accelerations() {
+        let b = two_storeys([0.02, 0.03]);
+        let (a, bm) = b.state_space();
+        let z = [0.01, -0.02, 0.3, 0.1, 0.5, -0.2];
+        let (ag, f) = (0.7, [3.0, -1.0]);
+        let p = DVector::from_vec(vec![ag, f[0], f[1]]);
+        let dz = &a * DVector::from_column_slice(&z) + &bm * &p;
+        let acc = b.accelerations(&z, &f);
+        for i in 0..2 {
+            assert!((dz[2 + i] - (acc[i] - ag)).abs() < 1e-12);
+            assert_eq!(dz[i], z[2 + i]);
+        }
+        assert_eq!((dz[4], dz[5]), (z[5], ag));
+    }
+
+    #[test]
+    fn designs_that_cannot_be_built_say_why() {
+        let bad = |d: Design| Building::new(&d).err().unwrap_or_default();
+        let good = Design {
+            masses: vec![1.0, 1.0],
+            stiffnesses: vec![10.0, 10.0],
+            zeta: [0.02, 0.02],
+            damper_floor: 2,
+            damper_mass: 0.0,
+        };
+        assert!(
+            bad(Design {
+                damper_floor: 3,
+                ..good.clone()
+            })
+            .contains("tld.floor = 3")
+        );
+        assert!(
+            bad(Design {
+                masses: vec![1.0, 0.0],
+                ..good.clone()
+            })
+            .contains("positive")
+        );
+        assert!(
+            bad(Design {
+                zeta: [0.01, 0.5],
+                ..good.clone()
+            })
+            .contains("negative coefficient")
+        );
+        assert!(Building::new(&good).is_ok());
+    }
+}

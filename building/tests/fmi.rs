@@ -1,0 +1,268 @@
+//! Building.fmu through its C entry points: the call sequence, bad input (refused with a logged
+//! reason, the instance unchanged and usable), state round trips, output derivatives, and the
+//! exact step against closed forms.
+
+mod host;
+
+use host::*;
+
+const ONE_STOREY: [(u32, f64); 3] = [
+    (vr::STOREYS, 1.0),
+    (vr::STOREY_1__MASS, 168.0),
+    (vr::STOREY_1__STIFFNESS, 5342.0),
+];
+
+fn three_storeys() -> Vec<(u32, f64)> {
+    vec![
+        (vr::STOREYS, 3.0),
+        (vr::STOREY_1__MASS, 60.0),
+        (vr::STOREY_1__MASS + 1, 60.0),
+        (vr::STOREY_1__MASS + 2, 50.0),
+        (vr::STOREY_1__STIFFNESS, 9600.0),
+        (vr::STOREY_1__STIFFNESS + 1, 8230.0),
+        (vr::STOREY_1__STIFFNESS + 2, 6860.0),
+        (vr::DAMPING_ZETA, 0.02),
+        (vr::TLD_MASS, 0.35),
+    ]
+}
+
+#[test]
+fn calls_out_of_order_are_refused_with_the_way_out() {
+    let mut inst = Instance::new("order");
+    assert_eq!(inst.do_step(0.01), ERROR);
+    assert!(
+        inst.logs()
+            .iter()
+            .any(|m| m.contains("fmi2DoStep is not allowed"))
+    );
+    inst.initialise(&ONE_STOREY);
+    assert_eq!(inst.do_step(0.01), OK);
+    assert_eq!(inst.setup(), ERROR);
+    assert_eq!(unsafe { inst.lib.fmi2Terminate(inst.c) }, OK);
+    assert_eq!(inst.do_step(0.01), ERROR);
+    assert_eq!(unsafe { inst.lib.fmi2Reset(inst.c) }, OK);
+    inst.time = 0.0;
+    inst.initialise(&ONE_STOREY);
+    assert_eq!(inst.do_step(0.01), OK);
+    // Model Exchange functions exist and refuse, naming this FMU.
+    assert_eq!(unsafe { inst.lib.fmi2SetTime(inst.c, 0.0) }, ERROR);
+    let said = inst.logs();
+    assert!(
+        said.iter()
+            .any(|m| m.contains("Building.fmu is a Co-Simulation FMU")),
+        "{said:?}"
+    );
+}
+
+/// Every bad value is refused with a message, and the instance is byte for byte as before.
+#[test]
+fn bad_input_is_refused_and_changes_nothing() {
+    let mut inst = Instance::new("bad");
+    inst.initialise(&three_storeys());
+    assert_eq!(inst.set_real(vr::GROUND_A, 0.3), OK);
+    assert_eq!(inst.do_step(0.01), OK);
+    let before = inst.serialised();
+    let refused = [
+        inst.set_real(vr::GROUND_A, f64::NAN),
+        inst.set_real(vr::TLD_FORCE, f64::INFINITY),
+        inst.set_real(vr::STOREY_1__MASS, 1.0), // fixed after initialisation
+        inst.set_real(vr::TLD_A, 1.0),          // an output
+        inst.set_real(9999, 1.0),
+        inst.derivative(vr::GROUND_A, 3, 1.0),
+        inst.derivative(vr::TLD_A, 1, 1.0),
+        inst.do_step(-0.01),
+        inst.do_step(0.0),
+        unsafe { inst.lib.fmi2DoStep(inst.c, inst.time + 1.0, 0.01, 1) },
+    ];
+    assert!(refused.iter().all(|&s| s == ERROR), "{refused:?}");
+    assert_eq!(inst.serialised(), before);
+    assert!(inst.logs().len() >= refused.len(), "{:?}", inst.logs());
+    assert_eq!(inst.do_step(0.01), OK, "still usable");
+}
+
+/// Inconsistent parameters are refused at fmi2ExitInitializationMode with the reason; fixed,
+/// the same instance initialises.
+#[test]
+fn inconsistent_parameters_say_why() {
+    let inst = Instance::new("params");
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.set_integer(vr::STOREYS, 0), ERROR);
+    assert_eq!(inst.set_integer(vr::STOREYS, 3), OK);
+    assert_eq!(inst.set_integer(vr::TLD_FLOOR, 5), OK);
+    assert_eq!(inst.exit(), ERROR);
+    assert!(
+        inst.logs().iter().any(|m| m.contains("tld.floor = 5")),
+        "{:?}",
+        inst.logs()
+    );
+    assert_eq!(inst.set_integer(vr::TLD_FLOOR, 2), OK);
+    // Mode 2's ratio far above mode 1's would need a negative mass coefficient.
+    assert_eq!(inst.set_real(vr::DAMPING_ZETA1, 0.01), OK);
+    assert_eq!(inst.set_real(vr::DAMPING_ZETA2, 0.5), OK);
+    assert_eq!(inst.exit(), ERROR);
+    assert!(
+        inst.logs()
+            .iter()
+            .any(|m| m.contains("negative coefficient"))
+    );
+    assert_eq!(inst.set_real(vr::DAMPING_ZETA1, -0.5), OK);
+    assert_eq!(inst.set_real(vr::DAMPING_ZETA2, 0.02), OK);
+    assert_eq!(inst.exit(), ERROR);
+    assert_eq!(inst.set_real(vr::DAMPING_ZETA1, -1.0), OK);
+    assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
+}
+
+/// A state saved mid-run continues bit for bit in another instance, and a corrupted one is
+/// refused.
+#[test]
+fn serialised_states_continue_bit_for_bit_elsewhere() {
+    let drive = |inst: &mut Instance, steps: usize| {
+        for _ in 0..steps {
+            let t = inst.time;
+            assert_eq!(inst.set_real(vr::GROUND_A, (5.0 * t).sin()), OK);
+            assert_eq!(inst.set_real(vr::TLD_FORCE, 2.0 * (3.0 * t).cos()), OK);
+            assert_eq!(inst.derivative(vr::GROUND_A, 1, 5.0 * (5.0 * t).cos()), OK);
+            assert_eq!(inst.do_step(0.01), OK);
+        }
+    };
+    let mut a = Instance::new("a");
+    a.initialise(&three_storeys());
+    drive(&mut a, 50);
+    let bytes = a.serialised();
+    let mut b = Instance::new("b");
+    assert_eq!(b.restore(&bytes), OK, "{:?}", b.logs());
+    b.time = a.time;
+    drive(&mut a, 50);
+    drive(&mut b, 50);
+    for r in [vr::TLD_A, vr::TLD_X, vr::ROOF_X, vr::BASE_SHEAR] {
+        assert_eq!(a.get_real(r).to_bits(), b.get_real(r).to_bits());
+    }
+    let mut bad = bytes.clone();
+    bad[bytes.len() / 2] ^= 1;
+    let c = Instance::new("c");
+    assert_eq!(c.restore(&bad), ERROR);
+    assert!(
+        c.logs().iter().any(|m| m.contains("checksum")),
+        "{:?}",
+        c.logs()
+    );
+}
+
+/// Output derivatives agree with central differences of the outputs over a ramped input.
+#[test]
+fn output_derivatives_are_the_outputs_slopes() {
+    let mut inst = Instance::new("rates");
+    inst.initialise(&three_storeys());
+    for _ in 0..40 {
+        let t = inst.time;
+        inst.set_real(vr::GROUND_A, 0.8 * (4.0 * t).sin());
+        inst.do_step(0.01);
+    }
+    let (slope, force_rate, dt) = (0.3, 40.0, 1e-4);
+    let outputs = [vr::TLD_A, vr::TLD_V, vr::TLD_X, vr::ROOF_X, vr::BASE_SHEAR];
+    let sample = |inst: &mut Instance, k: f64| {
+        inst.set_real(vr::GROUND_A, slope * k * dt);
+        inst.set_real(vr::TLD_FORCE, force_rate * k * dt);
+        outputs.map(|r| inst.get_real(r))
+    };
+    let y0 = sample(&mut inst, 0.0);
+    assert_eq!(inst.derivative(vr::GROUND_A, 1, slope), OK);
+    assert_eq!(inst.derivative(vr::TLD_FORCE, 1, force_rate), OK);
+    let rates = outputs.map(|r| inst.rate(r));
+    assert_eq!(inst.do_step(dt), OK);
+    let y1 = sample(&mut inst, 1.0);
+    for k in 0..outputs.len() {
+        let fd = (y1[k] - y0[k]) / dt;
+        let tol = 1e-3 * rates[k].abs().max(1e-6) + 1e-3 * dt * y0[k].abs().max(1.0);
+        assert!(
+            (fd - rates[k]).abs() < tol.max(1e-4 * (fd.abs() + rates[k].abs())),
+            "output {}: rate {} vs slope {fd}",
+            outputs[k],
+            rates[k]
+        );
+    }
+}
+
+/// One storey, free vibration from an initial push: the exact solution of the damped
+/// oscillator, whatever the step.
+#[test]
+fn one_storey_free_vibration_is_the_closed_form() {
+    let (m, k, zeta, f0, tp) = (168.0_f64, 5342.0_f64, 0.02, 100.0, 0.05);
+    let mut inst = Instance::new("free");
+    let mut params = ONE_STOREY.to_vec();
+    params.push((vr::DAMPING_ZETA, zeta));
+    inst.initialise(&params);
+    // A constant force for tp, then nothing: response = step response minus delayed one.
+    assert_eq!(inst.set_real(vr::TLD_FORCE, f0), OK);
+    assert_eq!(inst.do_step(tp), OK);
+    assert_eq!(inst.set_real(vr::TLD_FORCE, 0.0), OK);
+    let w = (k / m).sqrt();
+    let wd = w * (1.0 - zeta * zeta).sqrt();
+    let step = |t: f64| {
+        if t <= 0.0 {
+            return 0.0;
+        }
+        let e = (-zeta * w * t).exp();
+        f0 / k * (1.0 - e * ((wd * t).cos() + zeta * w / wd * (wd * t).sin()))
+    };
+    let mut worst = 0.0_f64;
+    for (n, h) in [(37, 0.013), (5, 0.21), (100, 0.001)] {
+        for _ in 0..n {
+            assert_eq!(inst.do_step(h), OK);
+            let t = inst.time;
+            let want = step(t) - step(t - tp);
+            worst = worst.max((inst.get_real(vr::FLOOR_1__X) - want).abs());
+        }
+    }
+    assert!(worst < 1e-13, "largest error {worst:e} m");
+}
+
+/// Exact within a step: a quadratic input over 2h in one step (value, first and second
+/// derivatives) ends where two steps of h end, the second started from the polynomial's value
+/// and derivatives at h; a held input likewise. Any integration error would differ between the
+/// two; the exponential's rounding does not reach 1e-12.
+#[test]
+fn one_long_step_equals_two_short_ones_for_polynomial_inputs() {
+    let (h, a0, a1, a2, f0, f1) = (0.37, 0.3, -1.1, 2.4, 5.0, -7.0);
+    let outputs = [
+        vr::FLOOR_1__X,
+        vr::ROOF_X,
+        vr::TLD_V,
+        vr::TLD_X,
+        vr::BASE_SHEAR,
+    ];
+    let run = |split: bool| {
+        let mut inst = Instance::new(if split { "split" } else { "whole" });
+        inst.initialise(&three_storeys());
+        let drive = |inst: &mut Instance, s: f64, h: f64| {
+            // ground.a = a0 + a1 t + a2 t^2/2, tld.force = f0 + f1 t, from time s
+            let a = a0 + a1 * s + a2 * s * s / 2.0;
+            assert_eq!(inst.set_real(vr::GROUND_A, a), OK);
+            assert_eq!(inst.set_real(vr::TLD_FORCE, f0 + f1 * s), OK);
+            assert_eq!(inst.derivative(vr::GROUND_A, 1, a1 + a2 * s), OK);
+            assert_eq!(inst.derivative(vr::GROUND_A, 2, a2), OK);
+            assert_eq!(inst.derivative(vr::TLD_FORCE, 1, f1), OK);
+            assert_eq!(inst.do_step(h), OK);
+        };
+        if split {
+            drive(&mut inst, 0.0, h);
+            drive(&mut inst, h, h);
+        } else {
+            drive(&mut inst, 0.0, 2.0 * h);
+        }
+        outputs.map(|r| inst.get_real(r))
+    };
+    let (whole, split) = (run(false), run(true));
+    for k in 0..outputs.len() {
+        let scale = whole[k].abs().max(1e-9);
+        assert!(
+            (whole[k] - split[k]).abs() < 1e-12 * scale.max(1.0),
+            "output {}: {} vs {}",
+            outputs[k],
+            whole[k],
+            split[k]
+        );
+        assert!(whole[k].abs() > 1e-6, "the run must move: {}", whole[k]);
+    }
+}

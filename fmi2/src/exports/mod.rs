@@ -1,0 +1,97 @@
+//! The bodies of the fmi2* C entry points, generic over the slave; [`crate::export_fmi2`]
+//! emits the `extern "C"` functions that call them (one monomorphised copy per FMU, inlined).
+//! Each is thin: it checks the call against its phase mask (the table in `calls`) and the
+//! pointers the host hands over, catches any panic, and delegates to [`Instance`]. Nothing here
+//! unwraps host data.
+#![allow(non_snake_case)]
+#![allow(clippy::missing_safety_doc)]
+
+mod lifecycle;
+mod state;
+mod values;
+
+pub use lifecycle::*;
+pub use state::*;
+pub use values::*;
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+use fmi_sys::fmi2::{fmi2Component, fmi2Status};
+
+use crate::calls::Call;
+use crate::description::log_category;
+use crate::host::{host_ref, host_slice, host_slice_mut, host_text};
+use crate::instance::Instance;
+use crate::slave::Slave;
+use crate::status::{Refusal, Reply, Status};
+
+/// The one way into an instance: `body` runs on the instance behind `c` if `call` is allowed in
+/// its phase; refusals become logged statuses, and a panic a logged fmi2Error that leaves the
+/// instance usable only for reset or free.
+#[inline(always)]
+fn guard<S: Slave>(
+    c: fmi2Component,
+    call: &'static Call,
+    body: impl FnOnce(&mut Instance<S>) -> Reply,
+) -> fmi2Status {
+    // SAFETY: `c` is what the host passed as our component; from_ptr accepts only our mark.
+    let Some(inst) = (unsafe { Instance::<S>::from_ptr(c) }) else {
+        return Status::Error as fmi2Status;
+    };
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        inst.require(call)?;
+        body(inst)
+    }));
+    // Every arm takes its value: nothing is left to drop on the way out.
+    match outcome {
+        Ok(Ok(Status::Ok)) if !inst.logs_calls() => Status::Ok as fmi2Status,
+        Ok(reply) => report(inst, call, reply),
+        Err(panic) => broken(inst, call, panic),
+    }
+}
+
+/// What `guard` tells the host about a call that was carried out with logging or a warning,
+/// or refused.
+#[cold]
+#[inline(never)]
+fn report<S: Slave>(inst: &mut Instance<S>, call: &Call, reply: Reply) -> fmi2Status {
+    match reply {
+        // Carried out (a warning has said why itself): traced when the host asked for logCalls.
+        Ok(status) => {
+            if inst.logs_calls() {
+                inst.log(Status::Ok, log_category::LOG_CALLS, call.name);
+            }
+            status as fmi2Status
+        }
+        Err(Refusal { status, message }) => {
+            let category = if status >= Status::Error {
+                log_category::LOG_STATUS_ERROR
+            } else {
+                log_category::LOG_STATUS_WARNING
+            };
+            inst.log(status, category, &message);
+            status as fmi2Status
+        }
+    }
+}
+
+/// A panic caught in `guard`: the instance is left usable only for reset or free.
+#[cold]
+#[inline(never)]
+fn broken<S: Slave>(
+    inst: &mut Instance<S>,
+    call: &Call,
+    panic: Box<dyn std::any::Any + Send>,
+) -> fmi2Status {
+    drop(panic);
+    inst.set_broken();
+    inst.log(
+        Status::Error,
+        log_category::LOG_STATUS_ERROR,
+        &format!(
+            "{}: internal error (please report it); call fmi2Reset or fmi2FreeInstance",
+            call.name
+        ),
+    );
+    Status::Error as fmi2Status
+}

@@ -1,0 +1,192 @@
+//! TLD.fmu as a slave of the shared FMI layer (`fmi2_slave`): the values the host set, the
+//! derivatives of base.a for the next step, and the damper once initialised. The shared layer
+//! has checked the call's phase and the host's pointers before any method here runs; every
+//! refusal leaves the slave as it was.
+
+use fmi2_slave::description::Table;
+use fmi2_slave::{Context, Refusal, Slave, refuse};
+
+use super::params::{Configuration, Values};
+use super::vars::{self, VARIABLES, finite, index_of, vr};
+use crate::model::{Damper, StepError};
+use crate::solver::SolveError;
+
+/// The model description as the shared layer reads it.
+pub static TABLE: Table = vars::TABLE;
+
+pub struct Tld {
+    pub(super) values: Values,
+    /// Whether the host set solver.tolerance itself (then fmi2SetupExperiment's tolerance does
+    /// not replace it).
+    pub(super) user_tolerance: bool,
+    /// Derivatives of base.a (orders 1 and 2) for the next step only.
+    pub(super) a_derivatives: [f64; 2],
+    pub(super) sim: Option<Damper>,
+}
+
+impl Tld {
+    pub(super) fn build(&self, context: &Context) -> Result<(Damper, Vec<String>), Refusal> {
+        Damper::configure(&self.configuration(context))
+            .map_err(|e| refuse(format!("the parameters are inconsistent: {e}")))
+    }
+
+    /// The parameters as the models read them.
+    fn configuration<'a>(&'a self, context: &Context) -> Configuration<'a> {
+        Configuration {
+            values: &self.values,
+            tolerance: context.experiment.tolerance,
+            user_tolerance: self.user_tolerance,
+        }
+    }
+
+    /// The running simulation, or during initialisation one built on the parameters set so
+    /// far (kept in `provisional` for the rest of the call).
+    pub(super) fn simulation<'a>(
+        &'a self,
+        context: &Context,
+        provisional: &'a mut Option<Damper>,
+    ) -> Result<&'a Damper, Refusal> {
+        if let Some(sim) = &self.sim {
+            return Ok(sim);
+        }
+        if provisional.is_none() {
+            *provisional = Some(self.build(context)?.0);
+        }
+        provisional.as_ref().ok_or_else(|| refuse("no simulation"))
+    }
+}
+
+impl Slave for Tld {
+    const TABLE: &'static Table = &TABLE;
+    const MARK: u64 = 0x544c_445f_464d_5532;
+    const STATE_TAG: [u8; 4] = *b"TLDs";
+    const STATE_VERSION: u16 = 1;
+
+    fn new() -> Self {
+        Tld {
+            values: Values::start(),
+            user_tolerance: false,
+            a_derivatives: [0.0; 2],
+            sim: None,
+        }
+    }
+
+    /// Kept inside the range the solver.tolerance parameter declares.
+    fn tolerance(t: f64) -> f64 {
+        let range = index_of(vr::SOLVER_TOLERANCE).and_then(|i| VARIABLES.get(i));
+        let lo = range.and_then(|v| v.min).unwrap_or(t);
+        let hi = range.and_then(|v| v.max).unwrap_or(t);
+        t.clamp(lo, hi)
+    }
+
+    fn initialise(&mut self, context: &Context) -> Result<Vec<String>, Refusal> {
+        let (sim, warnings) = self.build(context)?;
+        self.sim = Some(sim);
+        Ok(warnings)
+    }
+
+    #[inline]
+    fn step(&mut self, _: &Context, t: f64, h: f64) -> Result<bool, Refusal> {
+        debug_assert!(finite(t) && h > 0.0);
+        let inputs = self.values.inputs(self.a_derivatives);
+        let sim = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| refuse("fmi2DoStep: no simulation (not initialised)"))?;
+        match sim.step(t, h, &inputs) {
+            Ok(report) => {
+                // Input derivatives describe one communication step.
+                self.a_derivatives = [0.0; 2];
+                Ok(report.implausible)
+            }
+            Err(e) => Err(step_failed(t, h, e)),
+        }
+    }
+
+    #[inline(always)]
+    fn get<T>(
+        &self,
+        context: &Context,
+        vrs: &[u32],
+        out: &mut [T],
+        ty: vars::VarType,
+        function: &str,
+        to: fn(f64) -> T,
+    ) -> fmi2_slave::Reply {
+        self.get_values(context, vrs, out, ty, function, to)
+    }
+
+    #[inline(always)]
+    fn set<T: Copy>(
+        &mut self,
+        context: &Context,
+        vrs: &[u32],
+        values: &[T],
+        ty: vars::VarType,
+        function: &str,
+        from: fn(T) -> f64,
+    ) -> fmi2_slave::Reply {
+        self.set_values(context, vrs, values, ty, function, from)
+    }
+
+    fn set_input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> fmi2_slave::Reply {
+        self.input_derivatives(vrs, orders, values)
+    }
+
+    fn output_derivatives(
+        &self,
+        context: &Context,
+        vrs: &[u32],
+        orders: &[i32],
+        put: impl FnMut(usize, f64),
+    ) -> fmi2_slave::Reply {
+        self.rates(context, vrs, orders, put)
+    }
+
+    /// The damper's notice of implausible motion, to the host as a warning once per run.
+    fn notice(&mut self, context: &Context) -> Option<String> {
+        let a = self.values.get(vr::BASE_A);
+        let notice = self.sim.as_mut()?.notice(a)?;
+        Some(format!("fmi2DoStep to t = {}: {notice}", context.time))
+    }
+
+    fn flag(&self) -> bool {
+        self.user_tolerance
+    }
+
+    fn save(&self, out: &mut Vec<u8>) {
+        self.save_part(out)
+    }
+
+    fn load(
+        context: &Context,
+        flag: bool,
+        part: &mut fmi2_slave::frame::Reader,
+    ) -> Result<Self, String> {
+        Self::load_part(context, flag, part)
+    }
+}
+
+/// Why a step failed, as the host is told: fmi2Discard when a smaller step may succeed.
+#[cold]
+#[inline(never)]
+fn step_failed(t: f64, h: f64, e: StepError) -> Refusal {
+    let status = match e {
+        StepError::Solver(SolveError::TooManySteps { .. }) => fmi2_slave::Status::Discard,
+        _ => fmi2_slave::Status::Error,
+    };
+    let hint = if status == fmi2_slave::Status::Discard {
+        " The state is left at the start of the step; retry with a smaller communication step."
+    } else {
+        " The state is left at the start of the step."
+    };
+    Refusal::new(
+        status,
+        format!("fmi2DoStep from t = {t} by {h}: {e}.{hint}"),
+    )
+}
