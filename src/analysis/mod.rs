@@ -8,6 +8,7 @@ pub mod coupled;
 pub mod harmonic;
 pub mod linearisation;
 pub mod random;
+pub mod sweep;
 
 /// ln Gamma(x) for x > 0 (Lanczos, g = 7, 9 terms: about 1e-15 relative).
 pub fn ln_gamma(x: f64) -> f64 {

@@ -28,10 +28,9 @@ pub struct Damper {
     zeta: f64,
     last_mean_force: Option<f64>,
     /// Force of the liquid on the tanks [N] and the sloshing's displacement and velocity at the
-    /// current state, kept with the state: a master reads them after every step, where they are
-    /// loads.
-    force: f64,
-    sloshing: (f64, f64),
+    /// current state, kept with the state and indexed by their `Output` discriminants: a master
+    /// reads them after every step, where they are loads.
+    per_step: [f64; 3],
     /// Whether the run has been told of implausible motion.
     noticed: bool,
 }
@@ -78,8 +77,7 @@ impl Damper {
             common,
             derived,
             initial_energy: model.observe(Observable::Stored),
-            force: model.force(),
-            sloshing: model.sloshing(),
+            per_step: per_step(&model),
             model,
             tracker,
             amplitude,
@@ -144,21 +142,20 @@ impl Damper {
         // 1/h is ready long before the step's impulse is.
         let inv_h = 1.0 / h;
         let stepped = self.model.step(&step)?;
-        self.force = stepped.force;
-        self.sloshing = stepped.sloshing;
+        self.per_step = [stepped.force, stepped.sloshing.0, stepped.sloshing.1];
         // 1/h overflows for a subnormal h (and 0 x inf is NaN): over so short a step the mean
         // force is the force.
         let mean_force = stepped.impulse * inv_h;
         self.last_mean_force = Some(if mean_force.is_finite() {
             mean_force
         } else {
-            self.force
+            stepped.force
         });
         self.zeta = zeta;
         // Far beyond the walls (twice their distance): most likely a unit mistake, in the input
         // or the tank, which `notice` explains. An implausible input drives the sloshing there
         // within a step or two.
-        let implausible = self.sloshing.0.abs() > self.common.tank.length;
+        let implausible = stepped.sloshing.0.abs() > self.common.tank.length;
         Ok(Report {
             stats: stepped.stats,
             implausible,
@@ -177,7 +174,7 @@ impl Damper {
         }
         self.noticed = true;
         let length = self.common.tank.length;
-        let x = self.sloshing.0;
+        let x = self.x();
         Some(if a.abs() > IMPLAUSIBLE_ACCELERATION {
             format!(
                 "base.a = {a} m/s^2 is {:.0} g, implausible for a building floor: is it given in \
@@ -205,12 +202,15 @@ impl Damper {
     /// with no call and nothing that can panic. None for the others.
     #[inline(always)]
     pub fn per_step_output(&self, which: Output) -> Option<f64> {
-        match which {
-            Output::X => Some(self.sloshing.0),
-            Output::V => Some(self.sloshing.1),
-            Output::Force => Some(self.force),
-            _ => None,
-        }
+        self.per_step.get(which as usize).copied()
+    }
+
+    fn force(&self) -> f64 {
+        self.per_step[Output::Force as usize]
+    }
+
+    fn x(&self) -> f64 {
+        self.per_step[Output::X as usize]
     }
 
     /// Every output but those of [`Damper::per_step_output`].
@@ -219,9 +219,9 @@ impl Damper {
         let observe = |o| self.model.observe(o);
         match which {
             Output::X | Output::V | Output::Force => self.per_step_output(which).unwrap_or(0.0),
-            Output::ForceMean => self.last_mean_force.unwrap_or(self.force),
+            Output::ForceMean => self.last_mean_force.unwrap_or(self.force()),
             Output::BaseShear => {
-                self.force
+                self.force()
                     - self.derived.mass_inactive * inputs.a
                     - self.model.rigid_mass() * inputs.a
             }
@@ -236,7 +236,7 @@ impl Damper {
                 let k = usize::from(which == Output::SurfaceRight);
                 self.model
                     .surface()
-                    .map_or(self.mode_surface(k) * self.sloshing.0, |s| s[k])
+                    .map_or(self.mode_surface(k) * self.x(), |s| s[k])
             }
         }
     }
@@ -317,10 +317,15 @@ impl Damper {
         // The damping the last step used, which the model keeps for the output rates.
         damper.zeta = damper.common.zeta(damper.amplitude);
         damper.model.set_damping(damper.zeta);
-        damper.force = damper.model.force();
-        damper.sloshing = damper.model.sloshing();
+        damper.per_step = per_step(&damper.model);
         Ok(damper)
     }
+}
+
+/// The outputs a master reads after every step, at the model's state, in `Output` order.
+fn per_step(model: &AnyModel) -> [f64; 3] {
+    let (x, v) = model.sloshing();
+    [model.force(), x, v]
 }
 
 #[cfg(test)]

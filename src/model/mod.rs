@@ -37,15 +37,17 @@ pub struct Inputs {
 /// The outputs of the damper.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Output {
+    // The three a master reads after every step come first: their discriminants index the
+    // damper's array of them (`Damper::per_step_output`, a load with no branch on which).
     /// Force of the liquid on the tanks [N].
     Force,
+    /// Relative displacement [m] and velocity [m/s] of the (fundamental) sloshing mass.
+    X,
+    V,
     /// Impulse of `Force` over the last step / its length [N].
     ForceMean,
     /// `Force` minus the inertia of the liquid that moves with the tanks [N].
     BaseShear,
-    /// Relative displacement [m] and velocity [m/s] of the (fundamental) sloshing mass.
-    X,
-    V,
     /// Energies [J]: work input, dissipated, stored.
     EnergyInput,
     EnergyDissipated,

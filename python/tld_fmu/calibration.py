@@ -1,0 +1,114 @@
+"""Plots and the report of tld-calibrate's results (scripts/calibrate, scripts/calibration-report).
+
+tld-calibrate writes the samples with the fit (`--csv`: a `# phi=...` comment line, then
+lambda,kappa_data,kappa_model,zeta_data,zeta_model,kappa_nsd,zeta_nsd) and, for the shallow-water
+source, every swept point (`--sweeps`: lambda,direction,ratio,x,phase,x_peak,zeta_eq,cycles,settled).
+"""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+
+def read_fit(path: Path) -> tuple[dict[str, float], dict[str, np.ndarray]]:
+    """The fit (the comment line) and the sample columns of a --csv file."""
+    with open(path) as fh:
+        fit = {k: float(v) for k, v in
+               (kv.split("=", 1) for kv in fh.readline().lstrip("# ").strip().split(","))}
+        rows = list(csv.DictReader(fh))
+    cols = {k: np.array([float(r[k]) for r in rows]) for k in rows[0]} if rows else {}
+    return fit, cols
+
+
+def read_sweeps(path: Path) -> list[dict]:
+    """The swept points of a --sweeps file."""
+    with open(path) as fh:
+        return [{**r, **{k: float(r[k]) for k in ("lambda", "ratio", "x", "phase", "x_peak", "zeta_eq")},
+                 "cycles": int(r["cycles"]), "settled": r["settled"] == "1"}
+                for r in csv.DictReader(fh)]
+
+
+def plot(csv_path: Path, png: Path, title: str, sweeps_path: Path | None = None,
+         length: float | None = None) -> None:
+    """kappa(Lambda) and zeta(Lambda): the data, the fitted model and the NSD laws; with the
+    sweeps, a third panel with the swept response curves (amplitude over the tank half-length)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fit, d = read_fit(csv_path)
+    sweeps = read_sweeps(sweeps_path) if sweeps_path else []
+    panels = 3 if sweeps else 2
+    fig, axes = plt.subplots(1, panels, figsize=(5.5 * panels, 4.5))
+    a1, a2 = axes[0], axes[1]
+    lam = d["lambda"]
+    data_label = "shallow-water sweeps" if sweeps else "data"
+    a1.semilogx(lam, d["kappa_data"], "o", label=data_label)
+    a1.semilogx(lam, d["kappa_model"], "-",
+                label=f"Nonlinear model fitted: phi = {fit['phi']:.3g}, eta = {fit['eta']:.3g}")
+    a1.semilogx(lam, d["kappa_nsd"], "k--", lw=1, label="NSD law (fit of experiments)")
+    a1.set_xlabel("Lambda = A_e / a")
+    a1.set_ylabel("kappa = quadrature frequency / w_f")
+    a1.legend(fontsize=8)
+    a1.grid(alpha=0.3)
+    a2.loglog(lam, d["zeta_data"], "o", label=data_label)
+    a2.loglog(lam, d["zeta_model"], "-",
+              label=f"zeta = {fit['nsd_c']:.3g} Lambda^{fit['nsd_p']:.3g} fitted")
+    a2.loglog(lam, d["zeta_nsd"], "k--", lw=1, label="NSD law: 0.5 Lambda^0.35")
+    a2.set_xlabel("Lambda = A_e / a")
+    a2.set_ylabel("zeta (energy-equivalent at quadrature)")
+    a2.legend(fontsize=8)
+    a2.grid(alpha=0.3, which="both")
+    if sweeps:
+        a3 = axes[2]
+        half = (length or 1.0) / 2
+        for k, lv in enumerate(sorted({p["lambda"] for p in sweeps})):
+            colour = f"C{k % 10}"
+            for direction, style in (("up", "-"), ("down", ":")):
+                pts = [p for p in sweeps if p["lambda"] == lv and p["direction"] == direction]
+                pts.sort(key=lambda p: p["ratio"])
+                a3.semilogy([p["ratio"] for p in pts], [p["x"] / half for p in pts], style,
+                            color=colour, lw=1,
+                            label=f"Lambda = {lv:.3g}" if direction == "up" else None)
+        a3.set_xlabel("w / w_f")
+        a3.set_ylabel("first harmonic of slosh.x / (a/2)")
+        a3.set_title("up-sweeps solid, down-sweeps dotted", fontsize=8)
+        a3.legend(fontsize=7)
+        a3.grid(alpha=0.3, which="both")
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+
+
+def table(csv_path: Path, sweeps_path: Path) -> str:
+    """The report's markdown table for one tank: per Lambda the shallow-water kappa and zeta,
+    the NSD laws' and the fitted Nonlinear model's, and the jumps of the sweeps."""
+    fit, d = read_fit(csv_path)
+    sweeps = read_sweeps(sweeps_path)
+    lines = ["| Lambda | kappa SWE | kappa NSD | kappa fitted model | zeta SWE | zeta NSD "
+             "| up-sweep jump down | down-sweep jump up | unsettled points |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for i, lv in enumerate(d["lambda"]):
+        def jump(direction: str) -> str:
+            pts = sorted((p for p in sweeps if p["lambda"] == lv and p["direction"] == direction),
+                         key=lambda p: p["ratio"], reverse=direction == "down")
+            best = None
+            for p, q in zip(pts, pts[1:]):
+                change = p["x"] / q["x"] if direction == "up" else q["x"] / p["x"]
+                if change > 1.5 and (best is None or change > best[0]):
+                    best = (change, p["ratio"], q["ratio"])
+            return "none" if best is None else f"{best[1]:.2f} -> {best[2]:.2f} (x{best[0]:.1f})"
+        unsettled = sum(1 for p in sweeps if p["lambda"] == lv and not p["settled"])
+        lines.append(
+            f"| {lv:.4g} | {d['kappa_data'][i]:.3f} | {d['kappa_nsd'][i]:.3f} "
+            f"| {d['kappa_model'][i]:.3f} | {d['zeta_data'][i]:.4f} | {d['zeta_nsd'][i]:.4f} "
+            f"| {jump('up')} | {jump('down')} | {unsettled} |")
+    lines.append("")
+    lines.append(f"Fitted to these points: phi = {fit['phi']:.4g}, eta = {fit['eta']:.4g}, "
+                 f"nsd.c = {fit['nsd_c']:.4g}, nsd.p = {fit['nsd_p']:.4g} (the NSD laws' defaults: "
+                 f"nsd.c = 0.5, nsd.p = 0.35); largest kappa residual of the fitted model "
+                 f"{100 * fit['worst_kappa_residual']:.1f} %; w_f = {fit['omega_f']:.4f} rad/s.")
+    return "\n".join(lines)
