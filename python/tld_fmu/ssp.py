@@ -30,7 +30,11 @@ Hosts (each returns {"Component.variable": array over the communication points t
 with ssp_path), `run_fmpy` (fmpy.ssp: its SSD reader and its Jacobi step over the components).
 All three are Jacobi masters with inputs held over the step: every component steps from t_k with
 the outputs of the others at t_k, so they compute the same numbers up to the rounding of their
-clocks."""
+clocks.
+
+    .venv/bin/python -m tld_fmu.ssp                       # write systems/*.ssp from target/fmu
+    .venv/bin/python -m tld_fmu.ssp run systems/tld_table21.ssp [--host libcosim ...] [--csv F]
+"""
 from __future__ import annotations
 
 import ctypes
@@ -59,10 +63,13 @@ OSP_NS = "http://opensimulationplatform.com/SSP/OSPAnnotations"
 # component's (first) binding whatever its name
 PARAMETER_SET = "default"
 
+# the system's name inside the archive (OMSimulator's paths: <archive name>.root.Building.ground.a)
+SYSTEM = "root"
+
 SYSTEMS_DIR = REPO / "systems"
 BUILDING_EXAMPLE = REPO / "scripts" / "examples" / "building.toml"
 
-# (Building output, TLD input) and (TLD output, Building input): the coupling of SYSTEM.md
+# (Building output, TLD input) and (TLD output, Building input): the coupling of Building.fmu and TLD.fmu
 CONNECTIONS = [("Building", "tld.a", "TLD", "base.a"),
                ("Building", "tld.v", "TLD", "base.v"),
                ("Building", "tld.x", "TLD", "base.x"),
@@ -252,7 +259,7 @@ def ssd(name: str, description: str, contracts: dict, stop: float, step: float) 
             f'<ssd:SystemStructureDescription xmlns:ssd="{SSD_NS}" xmlns:ssc="{SSC_NS}" '
             f'xmlns:ssv="{SSV_NS}" xmlns:osp="{OSP_NS}" name={quoteattr(name)} version="1.0" '
             'generationTool="tld-fmu python/tld_fmu/ssp.py">\n'
-            f'  <ssd:System name="{name}" description={quoteattr(description + ". Building.ground.a (ground acceleration, m/s2) is the input the host sets each step.")}>\n'
+            f'  <ssd:System name="{SYSTEM}" description={quoteattr(description + ". Building.ground.a (ground acceleration, m/s2) is the input the host sets each step.")}>\n'
             '    <ssd:Elements>\n' + "\n".join(comps) + '\n    </ssd:Elements>\n'
             '    <ssd:Connections>\n' + "\n".join(conns) + '\n    </ssd:Connections>\n'
             '  </ssd:System>\n'
@@ -459,14 +466,60 @@ def harmonic_ground(w: float, amplitude: float):
                       amplitude * (1 - math.cos(w * t)))
 
 
+def run(ssp_path: Path, hosts, omega: float, amplitude: float, duration: float, h: float,
+        outputs=("Building.roof.x", "Building.base_shear", "TLD.force", "TLD.slosh.x")) -> dict:
+    """Run an archive in each of `hosts` under the ground motion x_g = amplitude (1 - cos omega t)
+    (ground.a held over each step of h); {host: {output: array at t_0..t_n}}."""
+    g = harmonic_ground(omega, amplitude)
+    a = [g(k * h)[0] for k in range(int(round(duration / h)))]
+    return {host: HOSTS[host](ssp_path, h, a, list(outputs)) for host in hosts}
+
+
 def main(argv=None):
     import argparse
-    ap = argparse.ArgumentParser(description="write systems/*.ssp from target/fmu/TLD.fmu and Building.fmu")
-    ap.add_argument("--out", default=str(SYSTEMS_DIR))
-    ap.add_argument("names", nargs="*", default=list(SYSTEMS))
+    ap = argparse.ArgumentParser(
+        description="Write systems/*.ssp from target/fmu/TLD.fmu and target/fmu/Building.fmu "
+                    "(no arguments), or run one archive in the SSP hosts (run ...).")
+    sub = ap.add_subparsers(dest="cmd")
+    w = sub.add_parser("write", help="write the archives (the default)")
+    w.add_argument("--out", default=str(SYSTEMS_DIR))
+    w.add_argument("names", nargs="*", default=list(SYSTEMS), choices=[[]] + list(SYSTEMS))
+    r = sub.add_parser("run", help="run an archive under harmonic ground motion in SSP hosts and compare them")
+    r.add_argument("ssp")
+    r.add_argument("--host", action="append", choices=list(HOSTS),
+                   help="libcosim, Ecos or fmpy (repeatable; default: all three)")
+    r.add_argument("--omega", type=float, default=5.6, help="ground motion frequency [rad/s] (5.6)")
+    r.add_argument("--amplitude", type=float, default=1e-4,
+                   help="ground displacement amplitude A [m]: x_g = A (1 - cos w t) (1e-4)")
+    r.add_argument("--duration", type=float, default=60.0, help="[s] (60)")
+    r.add_argument("--step", type=float, default=0.01, help="communication step [s] (0.01)")
+    r.add_argument("--csv", help="write the first host's time histories to this CSV file")
     args = ap.parse_args(argv)
-    for name in args.names:
-        print(write(name, Path(args.out)))
+    if args.cmd != "run":
+        out = Path(getattr(args, "out", SYSTEMS_DIR))
+        for name in getattr(args, "names", None) or list(SYSTEMS):
+            print(write(name, out))
+        return
+    hosts = args.host or list(HOSTS)
+    if "Ecos" in hosts:
+        import shutil
+        if not shutil.which("unzip"):
+            sys.exit("Ecos unpacks the FMUs with the system `unzip`: install it (apt-get install unzip)")
+    runs = run(Path(args.ssp), hosts, args.omega, args.amplitude, args.duration, args.step)
+    first = runs[hosts[0]]
+    n = len(next(iter(first.values()))) - 1
+    print(f"{args.ssp}: {n} steps of {args.step} s, x_g = {args.amplitude:g} (1 - cos {args.omega:g} t) m")
+    for host, res in runs.items():
+        print(f"  {host:9s} " + ", ".join(f"max|{o}| = {np.max(np.abs(v)):.9g}" for o, v in res.items()))
+    for host in hosts[1:]:
+        worst = max(float(np.max(np.abs(runs[host][o] - first[o])) / np.max(np.abs(first[o])))
+                    for o in first)
+        print(f"  {host} vs {hosts[0]}: max relative difference {worst:.2e}")
+    if args.csv:
+        cols = ["time"] + list(first)
+        data = np.column_stack([np.arange(n + 1) * args.step] + [first[o] for o in first])
+        np.savetxt(args.csv, data, delimiter=",", header=",".join(cols), comments="")
+        print(f"wrote {args.csv} ({hosts[0]})")
 
 
 if __name__ == "__main__":
