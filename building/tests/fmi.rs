@@ -44,8 +44,14 @@ fn calls_out_of_order_are_refused_with_the_way_out() {
     inst.time = 0.0;
     inst.initialise(&ONE_STOREY);
     assert_eq!(inst.do_step(0.01), OK);
-    // Model Exchange functions exist and refuse.
+    // Model Exchange functions exist and refuse, naming this FMU.
     assert_eq!(unsafe { inst.lib.fmi2SetTime(inst.c, 0.0) }, ERROR);
+    let said = inst.logs();
+    assert!(
+        said.iter()
+            .any(|m| m.contains("Building.fmu is a Co-Simulation FMU")),
+        "{said:?}"
+    );
 }
 
 /// Every bad value is refused with a message, and the instance is byte for byte as before.
@@ -210,4 +216,53 @@ fn one_storey_free_vibration_is_the_closed_form() {
         }
     }
     assert!(worst < 1e-13, "largest error {worst:e} m");
+}
+
+/// Exact within a step: a quadratic input over 2h in one step (value, first and second
+/// derivatives) ends where two steps of h end, the second started from the polynomial's value
+/// and derivatives at h; a held input likewise. Any integration error would differ between the
+/// two; the exponential's rounding does not reach 1e-12.
+#[test]
+fn one_long_step_equals_two_short_ones_for_polynomial_inputs() {
+    let (h, a0, a1, a2, f0, f1) = (0.37, 0.3, -1.1, 2.4, 5.0, -7.0);
+    let outputs = [
+        vr::FLOOR_1__X,
+        vr::ROOF_X,
+        vr::TLD_V,
+        vr::TLD_X,
+        vr::BASE_SHEAR,
+    ];
+    let run = |split: bool| {
+        let mut inst = Instance::new(if split { "split" } else { "whole" });
+        inst.initialise(&three_storeys());
+        let drive = |inst: &mut Instance, s: f64, h: f64| {
+            // ground.a = a0 + a1 t + a2 t^2/2, tld.force = f0 + f1 t, from time s
+            let a = a0 + a1 * s + a2 * s * s / 2.0;
+            assert_eq!(inst.set_real(vr::GROUND_A, a), OK);
+            assert_eq!(inst.set_real(vr::TLD_FORCE, f0 + f1 * s), OK);
+            assert_eq!(inst.derivative(vr::GROUND_A, 1, a1 + a2 * s), OK);
+            assert_eq!(inst.derivative(vr::GROUND_A, 2, a2), OK);
+            assert_eq!(inst.derivative(vr::TLD_FORCE, 1, f1), OK);
+            assert_eq!(inst.do_step(h), OK);
+        };
+        if split {
+            drive(&mut inst, 0.0, h);
+            drive(&mut inst, h, h);
+        } else {
+            drive(&mut inst, 0.0, 2.0 * h);
+        }
+        outputs.map(|r| inst.get_real(r))
+    };
+    let (whole, split) = (run(false), run(true));
+    for k in 0..outputs.len() {
+        let scale = whole[k].abs().max(1e-9);
+        assert!(
+            (whole[k] - split[k]).abs() < 1e-12 * scale.max(1.0),
+            "output {}: {} vs {}",
+            outputs[k],
+            whole[k],
+            split[k]
+        );
+        assert!(whole[k].abs() > 1e-6, "the run must move: {}", whole[k]);
+    }
 }

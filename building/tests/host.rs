@@ -30,18 +30,23 @@ impl log::Log for Capture {
     fn flush(&self) {}
 }
 
+/// The cdylib cargo builds with this test (the package's library, crate types cdylib and
+/// rlib), beside the test executable.
+pub fn library_path() -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable");
+    exe.parent().expect("deps").join(format!(
+        "{}building_fmu{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ))
+}
+
 pub fn library() -> &'static Fmi2Binding {
     static LIB: OnceLock<Fmi2Binding> = OnceLock::new();
     LIB.get_or_init(|| {
         let _ = log::set_logger(&Capture).map(|()| log::set_max_level(log::LevelFilter::Trace));
-        let exe = std::env::current_exe().expect("test executable");
-        let path: PathBuf = exe.parent().expect("deps").join(format!(
-            "{}building_fmu{}",
-            std::env::consts::DLL_PREFIX,
-            std::env::consts::DLL_SUFFIX
-        ));
         // SAFETY: our own library, built with this test.
-        unsafe { Fmi2Binding::new(&path) }.expect("load libbuilding_fmu.so")
+        unsafe { Fmi2Binding::new(library_path()) }.expect("load libbuilding_fmu.so")
     })
 }
 

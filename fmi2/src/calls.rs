@@ -81,9 +81,10 @@ impl Phase {
         }
     }
 
-    /// Why a call of `call` is refused in this phase, and what to do.
+    /// Why a call of `call` is refused in this phase, and what to do (`model`: the FMU's
+    /// modelIdentifier).
     #[cold]
-    pub fn refusal(self, call: &Call) -> String {
+    pub fn refusal(self, call: &Call, model: &str) -> String {
         if self == Phase::Broken {
             return format!(
                 "{} refused: an internal error made this instance unusable; call fmi2Reset or fmi2FreeInstance",
@@ -91,7 +92,7 @@ impl Phase {
             );
         }
         if let Some(why) = call.never {
-            return format!("{}: {why}", call.name);
+            return format!("{}: {}", call.name, why.replace("{model}", model));
         }
         format!(
             "{} is not allowed in state {self:?} (allowed in: {}).{}",
@@ -119,7 +120,9 @@ const fn call(name: &'static str, allowed: u8) -> Call {
     }
 }
 
-const CO_SIMULATION_ONLY: &str = "this is a Co-Simulation FMU; Model Exchange is not provided";
+/// `{model}` becomes the FMU's modelIdentifier in the refusal.
+const CO_SIMULATION_ONLY: &str =
+    "{model}.fmu is a Co-Simulation FMU; Model Exchange is not provided";
 
 const fn never(name: &'static str, why: &'static str) -> Call {
     Call {
@@ -205,9 +208,14 @@ mod tests {
             (Phase::Terminated, DO_STEP, "fmi2Reset"),
             (Phase::Broken, DO_STEP, "fmi2Reset"),
             (Phase::StepComplete, CANCEL_STEP, "asynchronous"),
+            (
+                Phase::StepComplete,
+                SET_TIME,
+                "TLD.fmu is a Co-Simulation FMU",
+            ),
         ];
         for (phase, call, hint) in cases {
-            let message = phase.refusal(&call);
+            let message = phase.refusal(&call, "TLD");
             assert!(message.contains(hint), "{phase:?} {}: {message}", call.name);
             assert!(message.starts_with(call.name), "{message}");
         }

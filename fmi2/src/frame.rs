@@ -229,3 +229,56 @@ impl<'a> Reader<'a> {
 pub fn unusable(why: &str) -> Refusal {
     refuse(format!("the FMU state is not usable: {why}"))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TAG: &[u8; 4] = b"TSTs";
+    const GUID: &str = "{guid}";
+
+    fn sample() -> (Common, Vec<u8>) {
+        let common = Common {
+            phase: Phase::StepComplete,
+            experiment: Experiment {
+                tolerance: Some(1e-6),
+                start: 0.5,
+                stop: None,
+            },
+            time: 2.25,
+            flag: true,
+        };
+        let bytes = encode(TAG, 3, GUID, &common, |out| put_f64_list(out, &[1.0, -2.5]));
+        (common, bytes)
+    }
+
+    #[test]
+    fn the_frame_round_trips_with_the_slaves_part() {
+        let (common, bytes) = sample();
+        let (read, mut part) = decode(&bytes, TAG, 3, GUID, "Test").expect("a good frame");
+        assert_eq!(read, common);
+        assert_eq!(part.f64_list(), Ok(vec![1.0, -2.5]));
+        assert_eq!(part.finish(), Ok(()));
+    }
+
+    /// Every kind of damage is named: tag, version, GUID, checksum, truncation, trailing bytes.
+    #[test]
+    fn a_damaged_frame_says_what_is_wrong() {
+        let (_, bytes) = sample();
+        let why = |b: &[u8]| decode(b, TAG, 3, GUID, "Test").err().unwrap_or_default();
+        assert!(why(&[b"XXXX", &bytes[4..]].concat()).contains("not a Test.fmu state"));
+        assert!(decode(&bytes, TAG, 4, GUID, "Test").is_err_and(|e| e.contains("version 3")));
+        assert!(decode(&bytes, TAG, 3, "{other}", "Test").is_err_and(|e| e.contains("GUID")));
+        let mut flipped = bytes.clone();
+        flipped[bytes.len() - 12] ^= 1;
+        assert!(why(&flipped).contains("checksum"));
+        assert!(why(&bytes[..bytes.len() - 3]).contains("truncated"));
+        assert!(why(&[&bytes[..], &[0u8]].concat()).contains("unexpected bytes"));
+        let (_, mut part) = decode(&bytes, TAG, 3, GUID, "Test").expect("good");
+        assert_eq!(part.u32(), Ok(2), "the list's length");
+        assert!(
+            part.finish().is_err(),
+            "a part read short has trailing bytes"
+        );
+    }
+}

@@ -96,8 +96,15 @@ impl<S: Slave> Instance<S> {
         if self.context.phase.bit() & call.allowed != 0 {
             Ok(())
         } else {
-            Err(refuse(self.context.phase.refusal(call)))
+            Err(self.refused(call))
         }
+    }
+
+    /// Why `call` is refused in this phase (out of line: the per-step calls pass).
+    #[cold]
+    #[inline(never)]
+    fn refused(&self, call: &Call) -> Refusal {
+        refuse(self.context.phase.refusal(call, S::TABLE.model_identifier))
     }
 
     pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Reply {

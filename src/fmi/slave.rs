@@ -103,6 +103,7 @@ impl Slave for Tld {
         }
     }
 
+    #[inline(always)]
     fn get<T>(
         &self,
         context: &Context,
@@ -115,6 +116,7 @@ impl Slave for Tld {
         self.get_values(context, vrs, out, ty, function, to)
     }
 
+    #[inline(always)]
     fn set<T: Copy>(
         &mut self,
         context: &Context,

@@ -233,3 +233,61 @@ def test_bad_input_is_refused_and_the_instance_goes_on(building):
     assert run.get("roof.x", "tld.a") == before
     run.step(0.01, {"ground.a": 0.1})
     run.close()
+
+
+def test_capabilities_and_model_structure(building_path):
+    """The declared feedthrough is the equations': absolute accelerations depend on the forces
+    (tld.a on tld.force and every floor force, floor[i].a on its own force and tld.force) and
+    not on ground.a; displacements, velocities and the base shear on the state only."""
+    from fmpy import read_model_description
+    md = read_model_description(str(building_path))
+    cs = md.coSimulation
+    assert cs.modelIdentifier == "Building" and cs.canHandleVariableCommunicationStepSize
+    assert cs.canInterpolateInputs and cs.maxOutputDerivativeOrder >= 1
+    assert cs.canGetAndSetFMUstate and cs.canSerializeFMUstate and not cs.needsExecutionTool
+    deps = {u.variable.name: {d.name for d in (u.dependencies or [])} for u in md.outputs}
+    floors = {f"floor[{i}].force" for i in range(1, 21)}
+    assert deps["tld.a"] == {"tld.force"} | floors
+    for i in range(1, 21):
+        assert deps[f"floor[{i}].a"] == {"tld.force", f"floor[{i}].force"}
+        assert deps[f"floor[{i}].x"] == set()
+    for n in ("tld.v", "tld.x", "roof.x", "base_shear"):
+        assert deps[n] == set(), n
+    assert all("ground.a" not in d for d in deps.values())
+
+
+def test_libcosim_runs_it_as_fmpy_does(building, building_path):
+    """libcosim (fixed step in integer nanoseconds, override manipulator, last-value observer,
+    a worker thread) and fmpy on libcosim's time grid give the same roof history to round-off
+    (the step sizes may differ in their last bits): the host adds nothing."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimManipulator import CosimManipulator
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+    log_output_level(CosimLogLevel.WARNING)
+    _, _, vr = building
+    ns, n = 10_000_000, 300
+    ground = [0.3 * np.sin(0.05 * k) for k in range(n)]
+    ex = CosimExecution.from_step_size(ns)
+    i = ex.add_local_slave(CosimLocalSlave(fmu_path=str(building_path), instance_name="building"))
+    assert i >= 0
+    assert ex.integer_initial_value(i, vr["storeys"], 3)
+    man, obs = CosimManipulator.create_override(), CosimObserver.create_last_value()
+    assert ex.add_manipulator(man) and ex.add_observer(obs)
+    cosim = []
+    for k in range(n):
+        assert man.slave_real_values(i, [vr["ground.a"]], [ground[k]])
+        assert ex.step(1)
+        cosim.append(obs.last_real_values(i, [vr["roof.x"]])[0])
+    del ex
+    run = Run(building, [168.0] * 3, [5342.0] * 3, 0.02)
+    direct = []
+    for k in range(n):
+        t0, t1 = k * ns * 1e-9, (k + 1) * ns * 1e-9
+        run.fmu.setReal([vr["ground.a"]], [ground[k]])
+        run.fmu.doStep(t0, t1 - t0)
+        direct.append(run.get("roof.x")[0])
+    run.close()
+    assert np.abs(direct).max() > 1e-4
+    np.testing.assert_allclose(cosim, direct, rtol=1e-12, atol=1e-15)

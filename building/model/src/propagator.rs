@@ -13,7 +13,7 @@
 //! q2' = 0). Exact up to the rounding of the exponential (scaling and squaring with a Pade
 //! approximant): a coupled run's error is its coupling's alone.
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVectorView, DVectorViewMut};
 
 /// Derivatives of the input beyond its value that a step uses (orders 1 and 2).
 pub const ORDERS: usize = 2;
@@ -48,13 +48,12 @@ impl Propagator {
     }
 
     /// z at the end of the step from `z` at its start and the input's Taylor coefficients
-    /// `p` = [p0, p1, p2] (each one value per channel), into `out`.
+    /// `p` = [p0, p1, p2] (each one value per channel), into `out` (matrix-vector products
+    /// down the columns, the matrices' storage order).
     pub fn advance(&self, z: &[f64], p: &[f64], out: &mut [f64]) {
-        for (i, slot) in out.iter_mut().enumerate() {
-            let free: f64 = self.phi.row(i).iter().zip(z).map(|(a, b)| a * b).sum();
-            let forced: f64 = self.gamma.row(i).iter().zip(p).map(|(a, b)| a * b).sum();
-            *slot = free + forced;
-        }
+        let mut out = DVectorViewMut::from_slice(out, self.phi.nrows());
+        out.gemv(1.0, &self.phi, &DVectorView::from_slice(z, z.len()), 0.0);
+        out.gemv(1.0, &self.gamma, &DVectorView::from_slice(p, p.len()), 1.0);
     }
 }
 

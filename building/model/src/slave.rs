@@ -14,7 +14,8 @@ use crate::propagator::{Cache, ORDERS};
 use crate::structure::{self, Design};
 
 /// A running building: its structure, first-order system, cached steps and state
-/// z = [u, u', x_g, v_g].
+/// z = [u, u', x_g, v_g], with room for a step's input polynomial and next state (a step
+/// allocates nothing).
 #[derive(Clone, Debug)]
 struct Simulation {
     building: structure::Building,
@@ -22,18 +23,23 @@ struct Simulation {
     b: DMatrix<f64>,
     cache: Cache,
     z: Vec<f64>,
+    p: Vec<f64>,
+    next: Vec<f64>,
 }
 
 impl Simulation {
     fn new(building: structure::Building) -> Self {
         let (a, b) = building.state_space();
-        let z = vec![0.0; building.states()];
+        let (z, next) = (vec![0.0; building.states()], vec![0.0; building.states()]);
+        let p = vec![0.0; (ORDERS + 1) * building.channels()];
         Simulation {
             building,
             a,
             b,
             cache: Cache::default(),
             z,
+            p,
+            next,
         }
     }
 }
@@ -124,27 +130,29 @@ fn output_of(r: u32) -> Option<Output> {
 }
 
 impl Building {
-    /// The input channels [a_g, F_1..F_n] of the step's polynomial: order 0 (the values), 1 or
-    /// 2 (the derivatives the host set). F_i is floor i's force, plus the damper's on its floor.
-    fn channels(&self, s: &Simulation, order: usize) -> Vec<f64> {
+    /// The input channels [a_g, F_1..F_n] of the step's polynomial into `out`: order 0 (the
+    /// values), 1 or 2 (the derivatives the host set). F_i is floor i's force, plus the
+    /// damper's on its floor.
+    fn fill_channels(&self, b: &structure::Building, order: usize, out: &mut [f64]) {
         let of = |r: u32| match (order, index_of(r)) {
             (0, Some(i)) => self.values[i],
             (k, Some(i)) => self.derivatives[i][k - 1],
             _ => 0.0,
         };
-        let b = &s.building;
-        let mut p = Vec::with_capacity(b.channels());
-        p.push(of(vr::GROUND_A));
+        out[0] = of(vr::GROUND_A);
         for i in 0..b.n {
-            let own = of(per_storey(vr::FLOOR_1__FORCE, i + 1));
-            p.push(
-                own + if i == b.damper {
-                    of(vr::TLD_FORCE)
-                } else {
-                    0.0
-                },
-            );
+            let damper = if i == b.damper {
+                of(vr::TLD_FORCE)
+            } else {
+                0.0
+            };
+            out[1 + i] = of(per_storey(vr::FLOOR_1__FORCE, i + 1)) + damper;
         }
+    }
+
+    fn channels(&self, s: &Simulation, order: usize) -> Vec<f64> {
+        let mut p = vec![0.0; s.building.channels()];
+        self.fill_channels(&s.building, order, &mut p);
         p
     }
 
@@ -255,20 +263,19 @@ impl Slave for Building {
         let Some(mut s) = self.sim.take() else {
             return Err(refuse("fmi2DoStep: no simulation (not initialised)"));
         };
-        let mut p = Vec::with_capacity((ORDERS + 1) * s.building.channels());
+        let m = s.building.channels();
         for order in 0..=ORDERS {
-            p.extend(self.channels(&s, order));
+            self.fill_channels(&s.building, order, &mut s.p[order * m..(order + 1) * m]);
         }
-        let mut next = vec![0.0; s.z.len()];
         let (a, b) = (&s.a, &s.b);
-        s.cache.get(h, a, b).advance(&s.z, &p, &mut next);
-        if !next.iter().all(|x| finite(*x)) {
+        s.cache.get(h, a, b).advance(&s.z, &s.p, &mut s.next);
+        if !s.next.iter().all(|x| finite(*x)) {
             self.sim = Some(s);
             return Err(refuse(format!(
                 "fmi2DoStep from t = {t} by {h}: the motion is no longer finite (inputs too large?). The state is left at the start of the step."
             )));
         }
-        s.z = next;
+        std::mem::swap(&mut s.z, &mut s.next);
         self.sim = Some(s);
         // Input derivatives describe one communication step.
         self.derivatives.iter_mut().for_each(|d| *d = [0.0; ORDERS]);
