@@ -59,7 +59,6 @@ import ctypes
 import os
 import shutil
 import stat
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -68,22 +67,13 @@ import pytest
 from conftest import MODELS_APART
 from ecos_unzip import write_standin
 from tld_fmu.contract import item, items
+from tld_fmu.ssp import load_tbb
 from host_scene import (
     DT, N, OUTPUTS, RTOL, T_END, base_acceleration, bitwise, compare, rel_diff, run_fmpy,
 )
 
 
-def _load_tbb():
-    """libecosc.so's libtbb.so.12: from the pinned `tbb` wheel (<venv>/lib), else the system."""
-    here = Path(sys.prefix) / "lib" / "libtbb.so.12"
-    try:
-        ctypes.CDLL(str(here) if here.is_file() else "libtbb.so.12", mode=ctypes.RTLD_GLOBAL)
-    except OSError as e:
-        raise RuntimeError(f"ecospy's libecosc.so needs libtbb.so.12: pip install tbb "
-                           f"(pinned in scripts/requirements.txt) ({e})") from e
-
-
-_load_tbb()
+load_tbb()
 # pinned in scripts/requirements.txt: a missing ecospy is an error here, not a skip
 from ecospy import EcosLib, EcosSimulation, EcosSimulationStructure, SimulationListener  # noqa: E402
 

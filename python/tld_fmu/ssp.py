@@ -1,0 +1,526 @@
+"""The coupled system Building.fmu + TLD.fmu as SSP 1.0 archives (System Structure and
+Parameterization), and runs of such an archive in the SSP hosts that install here.
+
+An archive (`.ssp`, a zip) holds
+    SystemStructure.ssd          the system: components Building and TLD, their connectors, the
+                                 connections, the units, a default experiment
+    resources/Building.fmu, resources/TLD.fmu
+    resources/Building.ssv, resources/TLD.ssv   each component's parameter values
+Connections: Building.tld.a -> TLD.base.a, tld.v -> base.v, tld.x -> base.x (the damper floor's
+absolute motion) and TLD.force -> Building.tld.force. TLD's `mass.inactive` (a calculated
+parameter: the liquid moving rigidly with the tanks) goes into Building's `tld.mass` as a value
+in Building.ssv, computed here by instantiating TLD.fmu with the system's TLD parameters: a
+parameter-to-parameter connection is not something the hosts evaluate before initialisation.
+
+Building.fmu's `ground.a` is left unconnected: the ground motion is the system's input, set by
+the host each step (Building.fmu has no built-in excitation; an unconnected input keeps its
+start value 0, so the default experiment alone leaves the system at rest).
+
+Everything named in the archive is read from the two FMUs' modelDescriptions (variable names,
+types, units, the Integer aliases of Enumerations), so the archive cannot drift from the FMUs;
+the .ssd and .ssv are validated against the SSP 1.0 schemas that fmpy ships.
+
+The systems are described like the configurations of tld_fmu.building ({"building": {"masses",
+"stiffnesses", "rayleigh"}, "dampers": [{"floor", "tanks", "params"}]}), with exactly one damper
+(Building.fmu carries one): `table21()` (the seed's Table 2.1 structure, tld_fmu.sdof) and the
+example 3-storey building of scripts/examples/building.toml.
+
+Hosts (each returns {"Component.variable": array over the communication points t_0..t_n}):
+`run_libcosim` (libcosimpy: CosimExecution.from_ssp_file), `run_ecos` (ecospy: EcosSimulation
+with ssp_path), `run_fmpy` (fmpy.ssp: its SSD reader and its Jacobi step over the components).
+All three are Jacobi masters with inputs held over the step: every component steps from t_k with
+the outputs of the others at t_k, so they compute the same numbers up to the rounding of their
+clocks.
+
+    .venv/bin/python -m tld_fmu.ssp                       # write systems/*.ssp from target/fmu
+    .venv/bin/python -m tld_fmu.ssp run systems/tld_table21.ssp [--host libcosim ...] [--csv F]
+"""
+from __future__ import annotations
+
+import ctypes
+import math
+import sys
+import tempfile
+import tomllib
+import zipfile
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from .contract import Contract
+from .paths import BUILDING_FMU, FMU, REPO
+
+SSD_NS = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+SSC_NS = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+SSV_NS = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+# libcosim reads its fixed-step algorithm from this annotation of the default experiment (and
+# matches the prefix `osp:` literally); other hosts ignore it.
+OSP_NS = "http://opensimulationplatform.com/SSP/OSPAnnotations"
+
+# the name of both components' parameter sets: Ecos merges the sets of one name across the
+# components and applies the one named in init(); libcosim and OMSimulator apply each
+# component's (first) binding whatever its name
+PARAMETER_SET = "default"
+
+# the system's name inside the archive (OMSimulator's paths: <archive name>.root.Building.ground.a)
+SYSTEM = "root"
+
+SYSTEMS_DIR = REPO / "systems"
+BUILDING_EXAMPLE = REPO / "scripts" / "examples" / "building.toml"
+
+# (Building output, TLD input) and (TLD output, Building input): the coupling of Building.fmu and TLD.fmu
+CONNECTIONS = [("Building", "tld.a", "TLD", "base.a"),
+               ("Building", "tld.v", "TLD", "base.v"),
+               ("Building", "tld.x", "TLD", "base.x"),
+               ("TLD", "force", "Building", "tld.force")]
+# more connectors declared (for hosts and tools that list them; the results the tests compare)
+EXTRA_CONNECTORS = {"Building": ["ground.a", "roof.x", "base_shear"],
+                    "TLD": ["slosh.x", "force.mean", "energy.dissipated"]}
+
+
+def table21():
+    """The seed's Table 2.1 structure (tld_fmu.sdof: M, zeta, w_s) as a 1-storey building with one
+    25 cm tank at TLD.fmu's defaults on its floor."""
+    from .sdof import K_S, M_S, ZETA_S
+    return {"building": {"masses": [M_S], "stiffnesses": [K_S], "rayleigh": [ZETA_S, ZETA_S]},
+            "dampers": [{"floor": 1, "tanks": 1, "params": {}}]}
+
+
+def building_example():
+    """The example 3-storey building of scripts/examples/building.toml (its building and damper)."""
+    cfg = tomllib.loads(BUILDING_EXAMPLE.read_text())
+    return {"building": cfg["building"], "dampers": cfg["dampers"]}
+
+
+# name of the archive in systems/ -> (description, configuration, default experiment (stop, step))
+SYSTEMS = {
+    "tld_table21": ("The seed's Table 2.1 structure (M = 168 kg, 0.32 % damping, w_s = 5.636 rad/s) "
+                    "with one 25 cm tank (TLD.fmu's defaults)", table21, (60.0, 0.01)),
+    "tld_building": ("The example 3-storey shear building of scripts/examples/building.toml with its "
+                     "tanks on the roof", building_example, (60.0, 0.01)),
+}
+
+
+def _one_damper(cfg):
+    dampers = cfg.get("dampers", [])
+    if len(dampers) != 1:
+        raise ValueError(f"an SSP system carries one damper (Building.fmu has one tld.floor), not {len(dampers)}")
+    return dampers[0]
+
+
+def tld_parameters(cfg, tld: Contract) -> dict:
+    """TLD.fmu's parameter values of the system {name: value}, as every host can set them: an
+    Enumeration through its Integer alias `<name>_id` (libcosim and Ecos cannot set
+    Enumerations; the alias overrides the enumeration), its item given by name or value."""
+    d = _one_damper(cfg)
+    out = {"tanks": int(d.get("tanks", 1))}
+    for name, value in d.get("params", {}).items():
+        var = tld.variable(name)
+        if var.type == "Enumeration":
+            alias = f"{name}_id"
+            if alias not in tld.variables:
+                raise KeyError(f"{name} is an Enumeration without an Integer alias {alias}")
+            out[alias] = int(tld.value(name, value))
+        else:
+            out[name] = value
+    return out
+
+
+def inactive_mass(tld_fmu: Path, params: dict) -> float:
+    """TLD.fmu's mass.inactive with these parameters (instantiated and initialised with fmpy)."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+    md = read_model_description(str(tld_fmu))
+    contract = Contract(md)
+    with tempfile.TemporaryDirectory(prefix="tld_ssp_") as d:
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(tld_fmu), d),
+                        modelIdentifier=md.coSimulation.modelIdentifier, instanceName="mass")
+        fmu.instantiate()
+        try:
+            fmu.setupExperiment(startTime=0.0)
+            contract.set(fmu, params)
+            fmu.enterInitializationMode()
+            fmu.exitInitializationMode()
+            return fmu.getReal([contract.vr("mass.inactive")])[0]
+        finally:
+            fmu.terminate()
+            fmu.freeInstance()
+
+
+def building_parameters(cfg, building: Contract, tld_mass: float) -> dict:
+    """Building.fmu's parameter values of the system {name: value}."""
+    b = cfg["building"]
+    masses, stiffnesses, (z1, z2) = b["masses"], b["stiffnesses"], b["rayleigh"]
+    if len(masses) != len(stiffnesses):
+        raise ValueError("one mass and one stiffness per storey")
+    out = {"storeys": len(masses), "tld.floor": int(_one_damper(cfg)["floor"])}
+    if z1 == z2:
+        out["damping.zeta"] = z1
+    else:
+        out["damping.zeta1"], out["damping.zeta2"] = z1, z2
+    for i, (m, k) in enumerate(zip(masses, stiffnesses), start=1):
+        out[f"storey[{i}].mass"], out[f"storey[{i}].stiffness"] = m, k
+    out["tld.mass"] = tld_mass
+    for name in out:
+        building.variable(name)   # every name exists in Building.fmu
+    return out
+
+
+def _real(x) -> str:
+    return repr(float(x))   # shortest round-trip form: the host reads back the same double
+
+
+def ssv(name: str, contract: Contract, values: dict) -> str:
+    """A parameter set (SystemStructureParameterValues 1.0) with each value typed as in the FMU."""
+    lines = []
+    for pname, value in values.items():
+        var = contract.variable(pname)
+        if var.type == "Real":
+            unit = f' unit={quoteattr(var.unit)}' if var.unit else ""
+            typed = f'<ssv:Real value="{_real(value)}"{unit}/>'
+        elif var.type == "Integer":
+            typed = f'<ssv:Integer value="{int(value)}"/>'
+        elif var.type == "Boolean":
+            typed = f'<ssv:Boolean value="{"true" if value else "false"}"/>'
+        else:
+            raise TypeError(f"{pname}: {var.type} parameters are not written (hosts cannot set them)")
+        lines.append(f'    <ssv:Parameter name={quoteattr(pname)}>{typed}</ssv:Parameter>')
+    units = _units(contract, [p for p in values if contract.variable(p).type == "Real"])
+    return ('<?xml version="1.0" encoding="UTF-8"?>\n'
+            f'<ssv:ParameterSet xmlns:ssv="{SSV_NS}" xmlns:ssc="{SSC_NS}" version="1.0" name={quoteattr(name)}>\n'
+            '  <ssv:Parameters>\n' + "\n".join(lines) + '\n  </ssv:Parameters>\n'
+            + _units_xml(units, "ssv", "  ") + '</ssv:ParameterSet>\n')
+
+
+def _units(contract: Contract, names) -> dict:
+    """{unit name: {base unit exponent: value}} of the named variables, from the modelDescription."""
+    defined = {u.name: u for u in contract.md.unitDefinitions}
+    out = {}
+    for n in names:
+        unit = contract.variable(n).unit
+        if unit:
+            bu = defined[unit].baseUnit
+            exps = {}
+            if bu is not None:
+                for k in ("kg", "m", "s", "A", "K", "mol", "cd", "rad", "factor", "offset"):
+                    v = getattr(bu, k, None)
+                    if v not in (None, 0) and not (k == "factor" and v == 1):
+                        exps[k] = v
+            out[unit] = exps
+    return out
+
+
+def _units_xml(units: dict, prefix: str, indent: str) -> str:
+    if not units:
+        return ""
+    rows = []
+    for name, exps in sorted(units.items()):
+        attrs = "".join(f' {k}="{v:g}"' if k in ("factor", "offset") else f' {k}="{int(v)}"'
+                        for k, v in exps.items())
+        rows.append(f'{indent}  <ssc:Unit name={quoteattr(name)}><ssc:BaseUnit{attrs}/></ssc:Unit>')
+    return f'{indent}<{prefix}:Units>\n' + "\n".join(rows) + f'\n{indent}</{prefix}:Units>\n'
+
+
+def connectors(contract: Contract, component: str) -> list[str]:
+    """The connectors of a component: its ends of the connections, then the extra outputs."""
+    names = [c[1] for c in CONNECTIONS if c[0] == component] + \
+            [c[3] for c in CONNECTIONS if c[2] == component] + EXTRA_CONNECTORS[component]
+    return list(dict.fromkeys(names))
+
+
+def ssd(name: str, description: str, contracts: dict, stop: float, step: float) -> str:
+    """SystemStructure.ssd (SystemStructureDescription 1.0) of the coupled system."""
+    comps, all_units = [], {}
+    for comp, contract in contracts.items():
+        rows = []
+        for cname in connectors(contract, comp):
+            var = contract.variable(cname)
+            if var.type != "Real" or var.causality not in ("input", "output"):
+                raise TypeError(f"{comp}.{cname}: connectors are Real inputs and outputs")
+            unit = f' unit={quoteattr(var.unit)}' if var.unit else ""
+            rows.append(f'          <ssd:Connector name={quoteattr(cname)} kind="{var.causality}">'
+                        f'<ssc:Real{unit}/></ssd:Connector>')
+        all_units.update(_units(contract, connectors(contract, comp)))
+        comps.append(
+            f'      <ssd:Component name="{comp}" type="application/x-fmu-sharedlibrary" '
+            f'source="resources/{comp}.fmu">\n'
+            '        <ssd:Connectors>\n' + "\n".join(rows) + '\n        </ssd:Connectors>\n'
+            '        <ssd:ParameterBindings>\n'
+            f'          <ssd:ParameterBinding type="application/x-ssp-parameter-set" source="resources/{comp}.ssv"/>\n'
+            '        </ssd:ParameterBindings>\n'
+            '      </ssd:Component>')
+    for a, ac, b, bc in CONNECTIONS:   # both ends must be an output and an input of the FMUs
+        if contracts[a].variable(ac).causality != "output" or contracts[b].variable(bc).causality != "input":
+            raise TypeError(f"{a}.{ac} -> {b}.{bc} is not output -> input")
+    conns = [f'      <ssd:Connection startElement="{a}" startConnector="{ac}" endElement="{b}" endConnector="{bc}"/>'
+             for a, ac, b, bc in CONNECTIONS]
+    return ('<?xml version="1.0" encoding="UTF-8"?>\n'
+            f'<ssd:SystemStructureDescription xmlns:ssd="{SSD_NS}" xmlns:ssc="{SSC_NS}" '
+            f'xmlns:ssv="{SSV_NS}" xmlns:osp="{OSP_NS}" name={quoteattr(name)} version="1.0" '
+            'generationTool="tld-fmu python/tld_fmu/ssp.py">\n'
+            f'  <ssd:System name="{SYSTEM}" description={quoteattr(description + ". Building.ground.a (ground acceleration, m/s2) is the input the host sets each step.")}>\n'
+            '    <ssd:Elements>\n' + "\n".join(comps) + '\n    </ssd:Elements>\n'
+            '    <ssd:Connections>\n' + "\n".join(conns) + '\n    </ssd:Connections>\n'
+            '  </ssd:System>\n'
+            + _units_xml(all_units, "ssd", "  ") +
+            f'  <ssd:DefaultExperiment startTime="0.0" stopTime="{_real(stop)}">\n'
+            '    <ssd:Annotations>\n'
+            '      <ssc:Annotation type="com.opensimulationplatform">\n'
+            f'        <osp:Algorithm><osp:FixedStepAlgorithm baseStepSize="{_real(step)}"/></osp:Algorithm>\n'
+            '      </ssc:Annotation>\n'
+            '    </ssd:Annotations>\n'
+            '  </ssd:DefaultExperiment>\n'
+            '</ssd:SystemStructureDescription>\n')
+
+
+def validate(xml: str, schema: str):
+    """Validate an .ssd or .ssv against fmpy's copy of the SSP 1.0 schema `schema`
+    (SystemStructureDescription.xsd or SystemStructureParameterValues.xsd); raises with the
+    schema's messages."""
+    import fmpy.ssp
+    from lxml import etree
+    xsd = etree.XMLSchema(file=str(Path(fmpy.ssp.__file__).parent / "schema" / schema))
+    doc = etree.fromstring(xml.encode())
+    if not xsd.validate(doc):
+        raise ValueError(f"not valid against SSP 1.0 {schema}:\n"
+                         + "\n".join(f"  line {e.line}: {e.message}" for e in xsd.error_log))
+
+
+def contents(name: str, tld_fmu: Path = FMU, building_fmu: Path = BUILDING_FMU) -> dict:
+    """The text files of system `name`'s archive {path in the archive: text}, validated."""
+    description, make, (stop, step) = SYSTEMS[name]
+    cfg = make()
+    tld, bld = Contract(str(tld_fmu)), Contract(str(building_fmu))
+    tp = tld_parameters(cfg, tld)
+    bp = building_parameters(cfg, bld, inactive_mass(tld_fmu, tp))
+    files = {"SystemStructure.ssd": ssd(name, description, {"Building": bld, "TLD": tld}, stop, step),
+             "resources/Building.ssv": ssv(PARAMETER_SET, bld, bp),
+             "resources/TLD.ssv": ssv(PARAMETER_SET, tld, tp)}
+    validate(files["SystemStructure.ssd"], "SystemStructureDescription.xsd")
+    for k in ("resources/Building.ssv", "resources/TLD.ssv"):
+        validate(files[k], "SystemStructureParameterValues.xsd")
+    return files
+
+
+def write(name: str, out_dir: Path = SYSTEMS_DIR, tld_fmu: Path = FMU,
+          building_fmu: Path = BUILDING_FMU) -> Path:
+    """Write systems/<name>.ssp: the text files of `contents` and both FMUs."""
+    files = contents(name, tld_fmu, building_fmu)
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    path = out_dir / f"{name}.ssp"
+    tmp = path.with_suffix(".ssp.tmp")
+    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+        for arc, text in files.items():
+            z.writestr(arc, text)
+        z.write(building_fmu, "resources/Building.fmu")
+        z.write(tld_fmu, "resources/TLD.fmu")
+    tmp.replace(path)
+    return path
+
+
+def read(ssp: Path, member: str) -> str:
+    with zipfile.ZipFile(ssp) as z:
+        return z.read(member).decode()
+
+
+# -- hosts ----------------------------------------------------------------------------------------
+
+def _columns(outputs):
+    return [tuple(o.split(".", 1)) for o in outputs]
+
+
+def run_libcosim(ssp: Path, h: float, ground_a, outputs) -> dict:
+    """libcosim (libcosimpy): the archive as libcosim loads it (CosimExecution.from_ssp_file, a
+    fixed-step execution of step h, integer nanoseconds), ground.a through an override
+    manipulator before each step, the outputs from a last-value observer. ground_a[k] is held
+    over step k; returns the outputs at t_0..t_n."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimManipulator import CosimManipulator
+    from libcosimpy.CosimObserver import CosimObserver
+    log_output_level(CosimLogLevel.WARNING)
+    ex = CosimExecution.from_ssp_file(str(Path(ssp).resolve()), round(h * 1e9))
+    index = {s.name.decode(): s.index for s in ex.slave_infos()}
+    vr = {name: {v.name.decode(): v.reference for v in ex.slave_variables(i)} for name, i in index.items()}
+    man, obs = CosimManipulator.create_override(), CosimObserver.create_last_value()
+    ex.add_manipulator(man)
+    ex.add_observer(obs)
+    cols = _columns(outputs)
+    n = len(ground_a)
+    res = np.empty((n + 1, len(cols)))
+    g = index["Building"], [vr["Building"]["ground.a"]]
+
+    def read(k):
+        for j, (c, v) in enumerate(cols):
+            res[k, j] = obs.last_real_values(index[c], [vr[c][v]])[0]
+    for k in range(n):
+        man.slave_real_values(g[0], g[1], [float(ground_a[k])])
+        ex.step(1)
+        if k == 0:
+            # the observer sees values after the first step only: t_0 is the state at rest
+            res[0] = 0.0
+        read(k + 1)
+    return {o: res[:, j] for j, o in enumerate(outputs)}
+
+
+def load_tbb():
+    """Load libecosc.so's libtbb.so.12 (before importing ecospy): from the pinned `tbb` wheel
+    (<venv>/lib), else the system's."""
+    here = Path(sys.prefix) / "lib" / "libtbb.so.12"
+    try:
+        ctypes.CDLL(str(here) if here.is_file() else "libtbb.so.12", mode=ctypes.RTLD_GLOBAL)
+    except OSError as e:
+        raise RuntimeError(f"ecospy's libecosc.so needs libtbb.so.12: pip install tbb "
+                           f"(pinned in scripts/requirements.txt) ({e})") from e
+
+
+def run_ecos(ssp: Path, h: float, ground_a, outputs) -> dict:
+    """Ecos (ecospy): EcosSimulation from the archive, ground.a set between steps (Ecos passes it
+    on right before the next fmi2DoStep), outputs read after each step. Needs `unzip` on PATH."""
+    load_tbb()
+    from ecospy import EcosSimulation
+    sim = EcosSimulation(ssp_path=str(Path(ssp).resolve()), step_size=h)
+    try:
+        sim.init(parameter_set=PARAMETER_SET)   # Ecos applies no set unless named
+        ident = [f"{c}::{v}" for c, v in _columns(outputs)]
+        n = len(ground_a)
+        res = np.empty((n + 1, len(ident)))
+        res[0] = [sim.get_real(i) for i in ident]
+        for k in range(n):
+            sim.set_real("Building::ground.a", float(ground_a[k]))
+            sim.step()
+            res[k + 1] = [sim.get_real(i) for i in ident]
+    finally:
+        sim.terminate()
+        sim.free()
+    return {o: res[:, j] for j, o in enumerate(outputs)}
+
+
+def run_fmpy(ssp: Path, h: float, ground_a, outputs) -> dict:
+    """fmpy's SSP support (fmpy.ssp): its reader of the archive (schema-validated), its
+    instantiation of the components and its Jacobi step `do_step` (set the inputs from the
+    connectors, fmi2DoStep, get the outputs), the connections applied after every step as
+    fmpy.ssp.simulate_ssp does. Two things simulate_ssp itself does not do are done here: it
+    applies no ParameterBinding of the SSD (only a parameter set passed to it), so each
+    component's .ssv is handed to it with the component's name prefixed; and it takes inputs
+    only on system connectors, one step late, so ground.a is set on Building's connector."""
+    from fmpy.ssp.simulation import do_step, free_fmu, instantiate_fmu
+    from fmpy.ssp.ssd import ParameterSet, find_components, find_connectors, read_ssd
+    from fmpy import extract
+    ssd_ = read_ssd(str(ssp))
+    components = {c.name: c for c in find_components(ssd_.system)}
+    for c in find_connectors(ssd_.system):
+        c.value = 0.0
+    conn = {(c.parent.name, c.name): c for comp in components.values() for c in comp.connectors}
+    # the SSD's connections as (start, end) connectors (fmpy.ssp.ssd.get_connections would wire
+    # the unconnected input ground.a to the source of the input listed before it)
+    connections = [(conn[(c.startElement, c.startConnector)], conn[(c.endElement, c.endConnector)])
+                   for c in ssd_.system.connections]
+    tmp = extract(str(ssp))
+    try:
+        for comp in components.values():
+            comp.parent = ssd_.system   # set by read_ssd; the prefix of set_parameters
+            params = ParameterSet(name=comp.name)
+            for binding in comp.parameterBindings:
+                for pset in binding.parameterValues:
+                    for p in pset.parameters:
+                        p.name = f"{comp.name}.{p.name}"
+                        params.parameters.append(p)
+            instantiate_fmu(comp, tmp, 0.0, None, params)
+        ground = conn[("Building", "ground.a")]
+        cols = _columns(outputs)
+        n = len(ground_a)
+        res = np.empty((n + 1, len(cols)))
+
+        def read(k):
+            from fmpy.ssp.simulation import get_value
+            res[k] = [get_value(components[c], v) for c, v in cols]
+        read(0)
+        t = 0.0
+        for k in range(n):
+            ground.value = float(ground_a[k])
+            for comp in components.values():
+                do_step(comp, t, h)
+            for start, end in connections:
+                end.value = start.value
+            t = (k + 1) * h
+            read(k + 1)
+        for comp in components.values():
+            free_fmu(comp)
+    finally:
+        import shutil
+        shutil.rmtree(tmp, ignore_errors=True)
+    return {o: res[:, j] for j, o in enumerate(outputs)}
+
+
+HOSTS = {"libcosim": run_libcosim, "Ecos": run_ecos, "fmpy": run_fmpy}
+
+
+def harmonic_ground(w: float, amplitude: float):
+    """Ground motion with x_g = amplitude (1 - cos w t) (at rest displaced by 0 at t = 0, zero-mean
+    velocity: what Building.fmu integrates from ground.a from rest) as ground(t) -> (a_g, v_g,
+    x_g), the form tld_fmu.building.simulate takes."""
+    return lambda t: (amplitude * w * w * math.cos(w * t), amplitude * w * math.sin(w * t),
+                      amplitude * (1 - math.cos(w * t)))
+
+
+def run(ssp_path: Path, hosts, omega: float, amplitude: float, duration: float, h: float,
+        outputs=("Building.roof.x", "Building.base_shear", "TLD.force", "TLD.slosh.x")) -> dict:
+    """Run an archive in each of `hosts` under the ground motion x_g = amplitude (1 - cos omega t)
+    (ground.a held over each step of h); {host: {output: array at t_0..t_n}}."""
+    g = harmonic_ground(omega, amplitude)
+    a = [g(k * h)[0] for k in range(int(round(duration / h)))]
+    return {host: HOSTS[host](ssp_path, h, a, list(outputs)) for host in hosts}
+
+
+def main(argv=None):
+    import argparse
+    ap = argparse.ArgumentParser(
+        description="Write systems/*.ssp from target/fmu/TLD.fmu and target/fmu/Building.fmu "
+                    "(no arguments), or run one archive in the SSP hosts (run ...).")
+    sub = ap.add_subparsers(dest="cmd")
+    w = sub.add_parser("write", help="write the archives (the default)")
+    w.add_argument("--out", default=str(SYSTEMS_DIR))
+    w.add_argument("names", nargs="*", default=list(SYSTEMS), choices=[[]] + list(SYSTEMS))
+    r = sub.add_parser("run", help="run an archive under harmonic ground motion in SSP hosts and compare them")
+    r.add_argument("ssp")
+    r.add_argument("--host", action="append", choices=list(HOSTS),
+                   help="libcosim, Ecos or fmpy (repeatable; default: all three)")
+    r.add_argument("--omega", type=float, default=5.6, help="ground motion frequency [rad/s] (5.6)")
+    r.add_argument("--amplitude", type=float, default=1e-4,
+                   help="ground displacement amplitude A [m]: x_g = A (1 - cos w t) (1e-4)")
+    r.add_argument("--duration", type=float, default=60.0, help="[s] (60)")
+    r.add_argument("--step", type=float, default=0.01, help="communication step [s] (0.01)")
+    r.add_argument("--csv", help="write the first host's time histories to this CSV file")
+    args = ap.parse_args(argv)
+    if args.cmd != "run":
+        out = Path(getattr(args, "out", SYSTEMS_DIR))
+        for name in getattr(args, "names", None) or list(SYSTEMS):
+            print(write(name, out))
+        return
+    hosts = args.host or list(HOSTS)
+    if "Ecos" in hosts:
+        import shutil
+        if not shutil.which("unzip"):
+            sys.exit("Ecos unpacks the FMUs with the system `unzip`: install it (apt-get install unzip)")
+    runs = run(Path(args.ssp), hosts, args.omega, args.amplitude, args.duration, args.step)
+    first = runs[hosts[0]]
+    n = len(next(iter(first.values()))) - 1
+    print(f"{args.ssp}: {n} steps of {args.step} s, x_g = {args.amplitude:g} (1 - cos {args.omega:g} t) m")
+    for host, res in runs.items():
+        print(f"  {host:9s} " + ", ".join(f"max|{o}| = {np.max(np.abs(v)):.9g}" for o, v in res.items()))
+    for host in hosts[1:]:
+        worst = max(float(np.max(np.abs(runs[host][o] - first[o])) / np.max(np.abs(first[o])))
+                    for o in first)
+        print(f"  {host} vs {hosts[0]}: max relative difference {worst:.2e}")
+    if args.csv:
+        cols = ["time"] + list(first)
+        data = np.column_stack([np.arange(n + 1) * args.step] + [first[o] for o in first])
+        np.savetxt(args.csv, data, delimiter=",", header=",".join(cols), comments="")
+        print(f"wrote {args.csv} ({hosts[0]})")
+
+
+if __name__ == "__main__":
+    main()
