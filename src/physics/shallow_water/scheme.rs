@@ -70,16 +70,40 @@ impl Rates {
     }
 }
 
+/// The smaller and the larger of two numbers, one instruction each (f64::min and max take
+/// seven, for NaN). A NaN anywhere in the state is refused at the end of the substep, so
+/// these need not handle it; whichever number they return then, the step is refused.
+#[inline(always)]
+fn smaller(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
+}
+
+#[inline(always)]
+fn larger(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
+/// The larger of a speed met so far and a new one; a NaN new one is passed over, as
+/// f64::max does.
+#[inline(always)]
+fn faster(speed: f64, new: f64) -> f64 {
+    if new > speed { new } else { speed }
+}
+
 /// Generalised minmod of the left and right differences.
-#[inline]
+#[inline(always)]
 fn limited(left: f64, right: f64) -> f64 {
     if left * right <= 0.0 {
         return 0.0;
     }
-    let central = 0.5 * (left + right);
-    let m = (THETA * left.abs())
-        .min(central.abs())
-        .min(THETA * right.abs());
+    let m = smaller(THETA * left.abs(), THETA * right.abs());
+    // The central difference bounds the others only for THETA > 1: for minmod, the mean of
+    // two differences of one sign is never below the smaller (nor is its rounding).
+    let m = if THETA > 1.0 {
+        smaller(m, (0.5 * (left + right)).abs())
+    } else {
+        m
+    };
     m.copysign(left)
 }
 
@@ -102,13 +126,15 @@ struct Side {
 }
 
 /// HLL flux (mass, momentum) between `l` and `r` with Einfeldt's wave speeds, and the largest
-/// |speed|. A side shallower than `dry` is dry: the front then runs at u -+ 2c of the wet side.
-#[inline]
-fn hll(l: Side, r: Side, g: f64, dry: f64) -> (f64, f64, f64) {
+/// |speed|, under gravity `g` (`root_g` its square root). A side shallower than `dry` is dry:
+/// the front then runs at u -+ 2c of the wet side.
+#[inline(always)]
+fn hll(l: Side, r: Side, g: f64, root_g: f64, dry: f64) -> (f64, f64, f64) {
     let (wet_l, wet_r) = (l.h >= dry, r.h >= dry);
     if !wet_l && !wet_r {
         return (0.0, 0.0, 0.0);
     }
+    let _ = root_g;
     let (cl, cr) = ((g * l.h).sqrt(), (g * r.h).sqrt());
     let (sl, sr) = if !wet_l {
         (r.u - 2.0 * cr, r.u + cr)
@@ -119,10 +145,10 @@ fn hll(l: Side, r: Side, g: f64, dry: f64) -> (f64, f64, f64) {
         let (rl, rr) = (l.h.sqrt(), r.h.sqrt());
         let u = (rl * l.u + rr * r.u) / (rl + rr);
         let c = (0.5 * g * (l.h + r.h)).sqrt();
-        ((l.u - cl).min(u - c), (r.u + cr).max(u + c))
+        (smaller(l.u - cl, u - c), larger(r.u + cr, u + c))
     };
     let flux = |s: Side| (s.h * s.u, s.h * s.u * s.u + 0.5 * g * s.h * s.h);
-    let speed = sl.abs().max(sr.abs());
+    let speed = larger(sl.abs(), sr.abs());
     if sl >= 0.0 {
         let (f, m) = flux(l);
         (f, m, speed)
@@ -138,78 +164,137 @@ fn hll(l: Side, r: Side, g: f64, dry: f64) -> (f64, f64, f64) {
     }
 }
 
+/// What a pass of the right-hand side gives besides the cell rates.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sweep {
+    /// Momentum flux (pressure per unit breadth over rho) at the walls x = 0 and x = a.
+    pub wall: [f64; 2],
+    /// Sum of the mass fluxes through the interior interfaces: dx times it is the rate of the
+    /// first moment of the depth.
+    pub mass_flux: f64,
+    /// Largest wave speed |s| of any interface [m/s].
+    pub speed: f64,
+}
+
+/// One cell's rates as [`sweep`] hands them on.
+#[derive(Clone, Copy, Debug)]
+pub struct CellRate {
+    /// dH_i/dt and dq_i/dt (without the drag, which the step integrates exactly).
+    pub depth: f64,
+    pub discharge: f64,
+    /// Mass flux through the cell's right face (0 at the right wall).
+    pub mass_flux: f64,
+}
+
 /// The semi-discrete right-hand side at depths `h` and discharges `q` under the base
-/// acceleration `a`, into `out`. Scratch: `slopes` (2 x cells).
-pub fn rates(grid: &Grid, h: &[f64], q: &[f64], a: f64, slopes: &mut [f64], out: &mut Rates) {
+/// acceleration `a`, in one pass over the cells: `cell(i, rate)` is called for i = 0, 1, ...,
+/// cells - 1 in order, as soon as both faces of cell i have their fluxes. Each cell's velocity
+/// is computed once, each interface's flux once, and nothing is stored per interface: what
+/// the next interface needs (the previous cell's right face, the differences across the
+/// interface behind) is carried in locals.
+#[inline(always)]
+pub fn sweep(
+    grid: &Grid,
+    h: &[f64],
+    q: &[f64],
+    a: f64,
+    mut cell: impl FnMut(usize, CellRate),
+) -> Sweep {
     let n = grid.cells;
+    let (h, q) = (&h[..n], &q[..n]);
     let (g, dry, dx) = (grid.g_e, grid.dry, grid.dx);
+    let root_g = g.sqrt();
+    let inv_dx = 1.0 / dx;
     // Rise of the pseudo-bottom z = a x / g_e from one cell centre to the next.
     let rise = a * dx / g;
-    let (dh, du) = slopes.split_at_mut(n);
-    // Cell velocities, desingularised.
-    let u = |i: usize| velocity(q[i], h[i], dry);
-    // Differences of the surface w = H + z and of u across interface j (between cells j-1
-    // and j); at the walls those with the mirror cell: 0 for w, -+2u for u.
-    let dw_at = |j: usize| {
-        if j == 0 || j == n {
-            0.0
-        } else {
-            h[j] - h[j - 1] + rise
+    // The differences of the surface w = H + z and of u across the right interface of cell i
+    // (depth, velocity u), and the depth and velocity of cell i + 1; at the right wall those
+    // with the mirror cell, 0 for w and -2u for u.
+    let ahead = |i: usize, depth: f64, u: f64| match h.get(i + 1).zip(q.get(i + 1)) {
+        Some((&hn, &qn)) => {
+            let un = velocity(qn, hn, dry);
+            (hn - depth + rise, un - u, hn, un)
         }
+        None => (0.0, -2.0 * u, depth, u),
     };
-    let du_at = |j: usize| {
-        if j == 0 {
-            2.0 * u(0)
-        } else if j == n {
-            -2.0 * u(n - 1)
-        } else {
-            u(j) - u(j - 1)
-        }
-    };
-    for i in 0..n {
-        let dw = limited(dw_at(i), dw_at(i + 1));
+    // The faces of a cell of depth `depth` and velocity `u` from those differences across its
+    // left and right interfaces.
+    let faces = |depth: f64, u: f64, dw: [f64; 2], du: [f64; 2]| {
         // Depth slope = surface slope - bottom slope, cut so that no face is negative.
         // (A NaN depth stays NaN, and the step that made it is refused.)
-        let most = 2.0 * h[i].max(0.0);
-        dh[i] = (dw - rise).max(-most).min(most);
-        du[i] = limited(du_at(i), du_at(i + 1));
-    }
-    // The faces of cell i: left (-) and right (+).
-    let face = |i: usize, side: f64| Side {
-        h: h[i] + side * 0.5 * dh[i],
-        u: u(i) + side * 0.5 * du[i],
+        let most = 2.0 * larger(depth, 0.0);
+        let dh = smaller(larger(limited(dw[0], dw[1]) - rise, -most), most);
+        let du = limited(du[0], du[1]);
+        (
+            Side {
+                h: depth - 0.5 * dh,
+                u: u - 0.5 * du,
+            },
+            Side {
+                h: depth + 0.5 * dh,
+                u: u + 0.5 * du,
+            },
+        )
     };
-    let mut speed: f64 = 0.0;
-    // Walls: mirror states; no mass flux by symmetry, so none is computed.
-    let wall = |s: Side, inward: f64| {
-        let ghost = Side { h: s.h, u: -s.u };
-        let (l, r) = if inward > 0.0 { (ghost, s) } else { (s, ghost) };
-        let (_, m, c) = hll(l, r, g, dry);
-        (m, c)
-    };
-    let (left_wall, c0) = wall(face(0, -1.0), 1.0);
-    let (right_wall, c1) = wall(face(n - 1, 1.0), -1.0);
-    speed = speed.max(c0).max(c1);
-    out.wall = [left_wall, right_wall];
-    let inv_dx = 1.0 / dx;
-    // Flux through the left face of the current cell.
-    let (mut f_in, mut m_in) = (0.0, left_wall);
-    // By index: each pass reads cells i and i + 1 and writes three arrays.
-    #[allow(clippy::needless_range_loop)]
-    for i in 0..n {
-        let (f_out, m_out) = if i + 1 < n {
-            let (f, m, c) = hll(face(i, 1.0), face(i + 1, -1.0), g, dry);
-            speed = speed.max(c);
-            out.mass_flux[i] = f;
-            (f, m)
-        } else {
-            (0.0, right_wall)
-        };
-        out.depth[i] = -(f_out - f_in) * inv_dx;
-        // The inertial force on the cell's liquid: -a_b H_i (the cell average, see above).
-        out.discharge[i] = -(m_out - m_in) * inv_dx - a * h[i];
-        f_in = f_out;
-        m_in = m_out;
+    let mirror = |s: Side| Side { h: s.h, u: -s.u };
+    let mut out = Sweep::default();
+    // Cell 0, whose left interface is the left wall (differences 0 for w, 2u for u): a mirror
+    // state, no mass flux by symmetry.
+    let (mut depth, mut u) = (h[0], velocity(q[0], h[0], dry));
+    let (mut dw_left, mut du_left, mut next_depth, mut next_u) = ahead(0, depth, u);
+    let (left, mut behind) = faces(depth, u, [0.0, dw_left], [2.0 * u, du_left]);
+    let (_, mut m_in, c) = hll(mirror(left), left, g, root_g, dry);
+    out.speed = faster(out.speed, c);
+    out.wall[0] = m_in;
+    // The flux through the left face of the cell whose rates are pending, and its depth.
+    let mut f_in = 0.0;
+    let mut pending = depth;
+    for i in 1..n {
+        (depth, u) = (next_depth, next_u);
+        let (dw_right, du_right, hn, un) = ahead(i, depth, u);
+        let (left, right) = faces(depth, u, [dw_left, dw_right], [du_left, du_right]);
+        let (f, m, c) = hll(behind, left, g, root_g, dry);
+        out.speed = faster(out.speed, c);
+        out.mass_flux += f;
+        cell(
+            i - 1,
+            CellRate {
+                depth: -(f - f_in) * inv_dx,
+                // The inertial force on the cell's liquid: -a_b H_i (the cell average).
+                discharge: -(m - m_in) * inv_dx - a * pending,
+                mass_flux: f,
+            },
+        );
+        (f_in, m_in, pending) = (f, m, depth);
+        behind = right;
+        (dw_left, du_left, next_depth, next_u) = (dw_right, du_right, hn, un);
     }
-    out.speed = speed;
+    // The right wall.
+    let (_, m, c) = hll(behind, mirror(behind), g, root_g, dry);
+    out.speed = faster(out.speed, c);
+    out.wall[1] = m;
+    cell(
+        n - 1,
+        CellRate {
+            depth: -(0.0 - f_in) * inv_dx,
+            discharge: -(m - m_in) * inv_dx - a * pending,
+            mass_flux: 0.0,
+        },
+    );
+    out
+}
+
+/// The semi-discrete right-hand side at depths `h` and discharges `q` under the base
+/// acceleration `a`, into `out`.
+pub fn rates(grid: &Grid, h: &[f64], q: &[f64], a: f64, out: &mut Rates) {
+    let n = grid.cells;
+    let s = sweep(grid, h, q, a, |i, r| {
+        out.depth[i] = r.depth;
+        out.discharge[i] = r.discharge;
+        if i + 1 < n {
+            out.mass_flux[i] = r.mass_flux;
+        }
+    });
+    out.wall = s.wall;
+    out.speed = s.speed;
 }
