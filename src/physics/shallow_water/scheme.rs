@@ -134,15 +134,15 @@ fn hll(l: Side, r: Side, g: f64, root_g: f64, dry: f64) -> (f64, f64, f64) {
     if !wet_l && !wet_r {
         return (0.0, 0.0, 0.0);
     }
-    let _ = root_g;
-    let (cl, cr) = ((g * l.h).sqrt(), (g * r.h).sqrt());
+    // Square roots of the depths: the Roe weights, and times sqrt(g) the celerities.
+    let (rl, rr) = (l.h.sqrt(), r.h.sqrt());
+    let (cl, cr) = (root_g * rl, root_g * rr);
     let (sl, sr) = if !wet_l {
         (r.u - 2.0 * cr, r.u + cr)
     } else if !wet_r {
         (l.u - cl, l.u + 2.0 * cl)
     } else {
         // Roe averages.
-        let (rl, rr) = (l.h.sqrt(), r.h.sqrt());
         let u = (rl * l.u + rr * r.u) / (rl + rr);
         let c = (0.5 * g * (l.h + r.h)).sqrt();
         (smaller(l.u - cl, u - c), larger(r.u + cr, u + c))
