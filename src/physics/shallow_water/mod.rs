@@ -212,6 +212,9 @@ impl Channel {
                     done.substeps += 1;
                     speed = sub.speed;
                     t = if last { h } else { t + dt };
+                    if !sub.finite {
+                        return Err(SolveError::NonFinite { t });
+                    }
                 }
                 // A wave faster than the step allows: take it again at the CFL step of that
                 // speed (the state is untouched until a substep is accepted).
@@ -219,9 +222,6 @@ impl Channel {
                     done.rejected += 1;
                     speed = faster;
                 }
-            }
-            if f.depth.iter().chain(&f.discharge).any(|v| !v.is_finite()) {
-                return Err(SolveError::NonFinite { t });
             }
         }
         Ok(done)
@@ -253,14 +253,16 @@ impl Channel {
         let dx = grid.dx;
         let limit = CFL_BOUND * dx / dt;
         let decay = (-0.5 * c * dt).exp();
-        // The drag's impulse on the tank is the momentum it takes from the liquid.
-        let p0 = self.momentum(f);
+        // The drag's impulse on the tank is the momentum it takes from the liquid: (1 - decay)
+        // times the momentum (the sum of the discharges, in order, times dx) before each half.
         let drag_loss = |p: f64| (1.0 - decay) * p;
         // U0 = the state after the first drag half: the depths are f's.
-        w.q0.iter_mut()
-            .zip(&f.discharge)
-            .for_each(|(a, q)| *a = q * decay);
-        let mut impulse = drag_loss(p0);
+        let mut p0 = -0.0;
+        for (a, &q) in w.q0.iter_mut().zip(&f.discharge) {
+            p0 += q;
+            *a = q * decay;
+        }
+        let mut impulse = drag_loss(p0 * dx);
         let mut fastest: f64 = 0.0;
         let mut wall = 0.0;
         let mut work = 0.0;
@@ -301,11 +303,12 @@ impl Channel {
         std::mem::swap(&mut f.discharge, q1);
         impulse += wall;
         // The second drag half, then the films: a dry cell's discharge goes to the bottom.
-        let p1 = self.momentum(f);
-        impulse += drag_loss(p1);
         let dry = grid.dry;
-        let mut stopped = 0.0;
+        let (mut p1, mut stopped) = (-0.0, 0.0);
+        let mut finite = true;
         for (h, q) in f.depth.iter_mut().zip(f.discharge.iter_mut()) {
+            finite &= h.is_finite() && q.is_finite();
+            p1 += *q;
             *q *= decay;
             // Round-off can leave a drained cell a few ulps below 0; the scheme's positivity
             // guarantees the rest.
@@ -315,11 +318,13 @@ impl Channel {
                 *q = 0.0;
             }
         }
+        impulse += drag_loss(p1 * dx);
         impulse += stopped * dx;
         Ok(Substep {
             impulse,
             work,
             speed: fastest,
+            finite,
         })
     }
 }
@@ -355,6 +360,8 @@ struct Substep {
     work: f64,
     /// Largest interface wave speed of its stages.
     speed: f64,
+    /// Whether the new state is finite (before the films are stopped).
+    finite: bool,
 }
 
 /// Depths and discharges: the state of the liquid in one tank.
