@@ -21,7 +21,8 @@
 //!
 //! Each run is repeated R times on a fresh instance; only the stepping loop is timed
 //! (std::time::Instant around it). Per run it writes DIR/ID.x.f64 (slosh.x at the N+1
-//! communication points; coupled scene also DIR/ID.X.f64, the structure's displacement) and
+//! communication points; open-loop scenes also DIR/ID.f.f64, force; coupled scene
+//! DIR/ID.X.f64, the structure's displacement) and
 //! prints `result ID ok N median_ns t1,t2,..` or `result ID fail STEP message`.
 
 mod baseline;
@@ -97,8 +98,8 @@ struct Coupled {
     m0: f64,
 }
 
-/// Open-loop scene: base.a[k] held over step k. Returns (elapsed ns, x history).
-fn run_open<D: Damper>(d: &mut D, a: &[f64], dt: f64) -> Result<(u128, Vec<f64>), (usize, String)> {
+/// Open-loop scene: base.a[k] held over step k. Returns (elapsed ns, x history, force history).
+fn run_open<D: Damper>(d: &mut D, a: &[f64], dt: f64) -> RunResult {
     let n = a.len();
     let mut xs = vec![0.0; n + 1];
     let mut vs = vec![0.0; n + 1];
@@ -113,13 +114,26 @@ fn run_open<D: Damper>(d: &mut D, a: &[f64], dt: f64) -> Result<(u128, Vec<f64>)
         fs[k + 1] = o[2];
     }
     let ns = t0.elapsed().as_nanos();
-    std::hint::black_box((&vs, &fs));
-    Ok((ns, xs))
+    std::hint::black_box(&vs);
+    Ok(Run {
+        ns,
+        x: xs,
+        big_x: vec![],
+        force: fs,
+    })
 }
 
-/// What a timed run gives: (ns in the stepping loop, slosh.x at the communication points,
-/// the structure's X for the coupled scene), or the step it failed at and why.
-type RunResult = Result<(u128, Vec<f64>, Vec<f64>), (usize, String)>;
+/// What a timed run gives: ns in the stepping loop, slosh.x at the communication points, the
+/// structure's X for the coupled scene and force for the open-loop ones (empty otherwise).
+struct Run {
+    ns: u128,
+    x: Vec<f64>,
+    big_x: Vec<f64>,
+    force: Vec<f64>,
+}
+
+/// A run, or the step it failed at and why.
+type RunResult = Result<Run, (usize, String)>;
 
 /// The co-simulation master of the coupled scene (explicit, force held over the step):
 /// at t_k, a_tank = (F_k - C V_k - K X_k)/(M + m0) is given to the damper as base.a, the damper
@@ -164,7 +178,12 @@ fn run_coupled<D: Damper>(d: &mut D, s: &Coupled, m0: f64, dt: f64) -> RunResult
         big_x[k + 1] = x;
     }
     let ns = t0.elapsed().as_nanos();
-    Ok((ns, xs, big_x))
+    Ok(Run {
+        ns,
+        x: xs,
+        big_x,
+        force: vec![],
+    })
 }
 
 fn kv(tokens: &[&str]) -> HashMap<String, String> {
@@ -230,7 +249,7 @@ enum Kind {
     Dp45(f64),
 }
 
-/// One repeat of a run: fresh damper, timed loop. Returns (ns, x, X).
+/// One repeat of a run: fresh damper, timed loop.
 fn once(st: &Settings, kind: &Kind) -> RunResult {
     let e0 = |e: String| (0usize, e);
     match kind {
@@ -243,7 +262,7 @@ fn once(st: &Settings, kind: &Kind) -> RunResult {
                     let m0 = inst.mass_inactive().map_err(e0)?;
                     run_coupled(&mut inst, c, m0, st.dt)
                 }
-                None => run_open(&mut inst, &st.input, st.dt).map(|(ns, x)| (ns, x, vec![])),
+                None => run_open(&mut inst, &st.input, st.dt),
             }
         }
         Kind::Rk4(sub, abs_span) => {
@@ -272,7 +291,7 @@ fn once(st: &Settings, kind: &Kind) -> RunResult {
 fn go<D: Damper>(d: &mut D, st: &Settings) -> RunResult {
     match &st.coupled {
         Some(c) => run_coupled(d, c, c.m0, st.dt),
-        None => run_open(d, &st.input, st.dt).map(|(ns, x)| (ns, x, vec![])),
+        None => run_open(d, &st.input, st.dt),
     }
 }
 
@@ -384,14 +403,14 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                     other => return Err(err(format!("unknown run kind {other}"))),
                 };
                 let mut times = Vec::new();
-                let mut first: Option<(Vec<f64>, Vec<f64>)> = None;
+                let mut first: Option<Run> = None;
                 let mut failure = None;
                 for _ in 0..st.repeats.max(1) {
                     match once(&st, &kind) {
-                        Ok((ns, x, big_x)) => {
-                            times.push(ns);
+                        Ok(run) => {
+                            times.push(run.ns);
                             if first.is_none() {
-                                first = Some((x, big_x));
+                                first = Some(run);
                             }
                         }
                         Err((k, e)) => {
@@ -406,10 +425,18 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                         writeln!(out, "result {id} fail {k} {}", e.replace('\n', " ")).ok();
                     }
                     None => {
-                        let (x, big_x) = first.unwrap();
+                        let Some(Run {
+                            x, big_x, force, ..
+                        }) = first
+                        else {
+                            return Err(err("no repeat ran".into()));
+                        };
                         write_f64(&format!("{}/{id}.x.f64", st.outdir), &x).map_err(err)?;
                         if !big_x.is_empty() {
                             write_f64(&format!("{}/{id}.X.f64", st.outdir), &big_x).map_err(err)?;
+                        }
+                        if !force.is_empty() {
+                            write_f64(&format!("{}/{id}.f.f64", st.outdir), &force).map_err(err)?;
                         }
                         let all: Vec<String> = times.iter().map(|t| t.to_string()).collect();
                         let med = median(&mut times.clone());
