@@ -23,7 +23,7 @@ mod tests;
 
 use crate::physics::base::BaseAcceleration;
 use crate::solver::SolveError;
-use scheme::{Grid, Rates, rates, sweep, velocity};
+use scheme::{Faces, Grid, Rates, rates, sweep, velocity};
 
 /// Courant number of a substep against the largest interface wave speed. The MUSCL-HLL
 /// forward-Euler stage keeps depths non-negative up to 1/2 (each cell average is the mean of
@@ -267,7 +267,14 @@ impl Channel {
         let mut wall = 0.0;
         let mut work = 0.0;
         let n = self.cells;
-        let Scratch { q0, h1, q1, h2, q2 } = w;
+        let Scratch {
+            q0,
+            h1,
+            q1,
+            h2,
+            q2,
+            faces,
+        } = w;
         let (h0, q0) = (&f.depth[..n], &q0[..n]);
         for (k, &(at, weight, beta)) in STAGES.iter().enumerate() {
             let a = base.at(t + at * dt);
@@ -283,7 +290,7 @@ impl Channel {
             // Next stage: (1 - beta) U0 + beta (U_k + dt L(U_k)), cell by cell as the rates
             // come.
             let alpha = 1.0 - beta;
-            let s = sweep(&grid, hk, qk, a, |i, r| {
+            let s = sweep(&grid, hk, qk, a, faces, |i, r| {
                 hn[i] = alpha * h0[i] + beta * (hk[i] + dt * r.depth);
                 qn[i] = alpha * q0[i] + beta * (qk[i] + dt * r.discharge);
             });
@@ -382,6 +389,7 @@ pub struct Scratch {
     q1: Vec<f64>,
     h2: Vec<f64>,
     q2: Vec<f64>,
+    faces: Faces,
 }
 
 impl Scratch {
@@ -393,6 +401,7 @@ impl Scratch {
             q1: v(),
             h2: v(),
             q2: v(),
+            faces: Faces::new(cells),
         }
     }
 }
