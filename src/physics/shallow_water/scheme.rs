@@ -182,16 +182,6 @@ pub struct Sweep {
     pub speed: f64,
 }
 
-/// One cell's rates as [`sweep`] hands them on.
-#[derive(Clone, Copy, Debug)]
-pub struct CellRate {
-    /// dH_i/dt and dq_i/dt (without the drag, which the step integrates exactly).
-    pub depth: f64,
-    pub discharge: f64,
-    /// Mass flux through the cell's right face (0 at the right wall).
-    pub mass_flux: f64,
-}
-
 /// The faces of a cell of depth `depth` and velocity `u` from the differences of the surface
 /// w = H + z and of u across its left and right interfaces, `rise` the pseudo-bottom's rise
 /// from one cell to the next: (left depth, left velocity, right depth, right velocity).
@@ -210,11 +200,13 @@ fn faces_of(depth: f64, u: f64, dw: [f64; 2], du: [f64; 2], rise: f64) -> (f64, 
     )
 }
 
-/// Storage of [`sweep`]: per cell its velocity and the depths and velocities of its two faces,
-/// per interface (cells + 1, the walls included) the mass and momentum fluxes and the largest
-/// wave speed.
+/// Storage of [`sweep`]: per cell its velocity, the depths and velocities of its two faces and
+/// its rates, per interface (cells + 1, the walls included) the mass and momentum fluxes and
+/// the largest wave speed.
 #[derive(Debug)]
 pub struct Faces {
+    depth_rate: Vec<f64>,
+    discharge_rate: Vec<f64>,
     u: Vec<f64>,
     left_h: Vec<f64>,
     left_u: Vec<f64>,
@@ -229,6 +221,8 @@ impl Faces {
     pub fn new(cells: usize) -> Self {
         let v = |n| vec![0.0; n];
         Faces {
+            depth_rate: v(cells),
+            discharge_rate: v(cells),
             u: v(cells),
             left_h: v(cells),
             left_u: v(cells),
@@ -239,10 +233,22 @@ impl Faces {
             speed: v(cells + 1),
         }
     }
+
+    /// dH_i/dt and dq_i/dt of the last [`sweep`] (without the drag, which the step
+    /// integrates exactly).
+    pub fn rates(&self) -> (&[f64], &[f64]) {
+        (&self.depth_rate, &self.discharge_rate)
+    }
+
+    /// The mass fluxes through the interior interfaces of the last [`sweep`] (cells - 1).
+    pub fn mass_fluxes(&self) -> &[f64] {
+        let n = self.u.len();
+        &self.mass[1..n]
+    }
 }
 
 /// The semi-discrete right-hand side at depths `h` and discharges `q` under the base
-/// acceleration `a`: `cell(i, rate)` is called for i = 0, 1, ..., cells - 1 in order.
+/// acceleration `a`, into `faces` ([`Faces::rates`], [`Faces::mass_fluxes`]).
 ///
 /// In passes over the cells and the interfaces, each a loop without branches that the
 /// compiler vectorises: the velocities (a division each), the faces, the fluxes (3 square
@@ -251,46 +257,25 @@ impl Faces {
 /// (checked once per call, a cached flag), the same code compiled for AVX2 runs, 4 lanes
 /// wide: the same operations on the same numbers in the same order (no fused multiply-adds,
 /// nothing reassociated), so the results are bit for bit those of the baseline build.
-pub fn sweep(
-    grid: &Grid,
-    h: &[f64],
-    q: &[f64],
-    a: f64,
-    faces: &mut Faces,
-    cell: impl FnMut(usize, CellRate),
-) -> Sweep {
+pub fn sweep(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: sweep_avx2 only needs AVX2, which this CPU has (just checked).
-        return unsafe { sweep_avx2(grid, h, q, a, faces, cell) };
+        return unsafe { sweep_avx2(grid, h, q, a, faces) };
     }
-    sweep_passes(grid, h, q, a, faces, cell)
+    sweep_passes(grid, h, q, a, faces)
 }
 
 /// [`sweep_passes`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn sweep_avx2(
-    grid: &Grid,
-    h: &[f64],
-    q: &[f64],
-    a: f64,
-    faces: &mut Faces,
-    cell: impl FnMut(usize, CellRate),
-) -> Sweep {
-    sweep_passes(grid, h, q, a, faces, cell)
+fn sweep_avx2(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
+    sweep_passes(grid, h, q, a, faces)
 }
 
 /// The passes of [`sweep`], for any CPU (the baseline build).
 #[inline(always)]
-pub(super) fn sweep_passes(
-    grid: &Grid,
-    h: &[f64],
-    q: &[f64],
-    a: f64,
-    faces: &mut Faces,
-    mut cell: impl FnMut(usize, CellRate),
-) -> Sweep {
+pub(super) fn sweep_passes(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
     let n = grid.cells;
     let (h, q) = (&h[..n], &q[..n]);
     let (g, dry, dx) = (grid.g_e, grid.dry, grid.dx);
@@ -300,6 +285,8 @@ pub(super) fn sweep_passes(
     let rise = a * dx / g;
     // All of the cells' (interfaces') length: no bounds checks in the passes.
     let Faces {
+        depth_rate,
+        discharge_rate,
         u,
         left_h,
         left_u,
@@ -380,21 +367,11 @@ pub(super) fn sweep_passes(
         mass_flux: mass[1..n].iter().fold(0.0, |sum, f| sum + f),
         speed: lanes.into_iter().fold(0.0, faster),
     };
-    for (i, ((&h, f), m)) in h
-        .iter()
-        .zip(mass.windows(2))
-        .zip(momentum.windows(2))
-        .enumerate()
-    {
-        cell(
-            i,
-            CellRate {
-                depth: -(f[1] - f[0]) * inv_dx,
-                // The inertial force on the cell's liquid: -a_b H_i (the cell average).
-                discharge: -(m[1] - m[0]) * inv_dx - a * h,
-                mass_flux: f[1],
-            },
-        );
+    let rates = depth_rate[..n].iter_mut().zip(&mut discharge_rate[..n]);
+    for (((dh, dq), &h), (f, m)) in rates.zip(h).zip(mass.windows(2).zip(momentum.windows(2))) {
+        *dh = -(f[1] - f[0]) * inv_dx;
+        // The inertial force on the cell's liquid: -a_b H_i (the cell average).
+        *dq = -(m[1] - m[0]) * inv_dx - a * h;
     }
     out
 }
@@ -402,14 +379,12 @@ pub(super) fn sweep_passes(
 /// The semi-discrete right-hand side at depths `h` and discharges `q` under the base
 /// acceleration `a`, into `out`.
 pub fn rates(grid: &Grid, h: &[f64], q: &[f64], a: f64, out: &mut Rates) {
-    let n = grid.cells;
-    let s = sweep(grid, h, q, a, &mut Faces::new(n), |i, r| {
-        out.depth[i] = r.depth;
-        out.discharge[i] = r.discharge;
-        if i + 1 < n {
-            out.mass_flux[i] = r.mass_flux;
-        }
-    });
+    let mut faces = Faces::new(grid.cells);
+    let s = sweep(grid, h, q, a, &mut faces);
+    let (dh, dq) = faces.rates();
+    out.depth.copy_from_slice(dh);
+    out.discharge.copy_from_slice(dq);
+    out.mass_flux.copy_from_slice(faces.mass_fluxes());
     out.wall = s.wall;
     out.speed = s.speed;
 }
