@@ -253,16 +253,58 @@ impl Faces {
 /// In passes over the cells and the interfaces, each a loop without branches that the
 /// compiler vectorises: the velocities (a division each), the faces, the fluxes (3 square
 /// roots and 2 divisions each), then the rates. The divisions and square roots bound the
-/// cost; vectorised, they take a fraction of their scalar time. Where the CPU has AVX2
-/// (checked once per call, a cached flag), the same code compiled for AVX2 runs, 4 lanes
-/// wide: the same operations on the same numbers in the same order (no fused multiply-adds,
-/// nothing reassociated), so the results are bit for bit those of the baseline build.
+/// cost; vectorised, they take a fraction of their scalar time. LLVM declines 2-lane SSE2
+/// for the flux loop, so the same code is also compiled for AVX-512F (8 lanes) and AVX2 (4
+/// lanes) and the widest the CPU has runs (checked per call: a cached flag). The same
+/// operations on the same numbers in the same order (no fused multiply-adds, nothing
+/// reassociated): the results are bit for bit those of the baseline build (tested).
 pub fn sweep(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: sweep_avx2 only needs AVX2, which this CPU has (just checked).
-        return unsafe { sweep_avx2(grid, h, q, a, faces) };
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: sweep_avx512 only needs AVX-512F, which this CPU has (just checked).
+            return unsafe { sweep_avx512(grid, h, q, a, faces) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: sweep_avx2 only needs AVX2, which this CPU has (just checked).
+            return unsafe { sweep_avx2(grid, h, q, a, faces) };
+        }
     }
+    sweep_passes(grid, h, q, a, faces)
+}
+
+/// Every build of [`sweep_passes`] this CPU can run, by name, each given to `check` with what
+/// it left in `faces` (the tests compare them).
+#[cfg(test)]
+pub(super) fn each_build(
+    grid: &Grid,
+    h: &[f64],
+    q: &[f64],
+    a: f64,
+    faces: &mut Faces,
+    mut check: impl FnMut(&str, Sweep, &Faces),
+) {
+    let s = sweep_passes(grid, h, q, a, faces);
+    check("baseline", s, faces);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: this CPU has AVX2 (just checked).
+            let s = unsafe { sweep_avx2(grid, h, q, a, faces) };
+            check("avx2", s, faces);
+        }
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: this CPU has AVX-512F (just checked).
+            let s = unsafe { sweep_avx512(grid, h, q, a, faces) };
+            check("avx512f", s, faces);
+        }
+    }
+}
+
+/// [`sweep_passes`] compiled for AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn sweep_avx512(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
     sweep_passes(grid, h, q, a, faces)
 }
 
@@ -275,7 +317,7 @@ fn sweep_avx2(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> S
 
 /// The passes of [`sweep`], for any CPU (the baseline build).
 #[inline(always)]
-pub(super) fn sweep_passes(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
+fn sweep_passes(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
     let n = grid.cells;
     let (h, q) = (&h[..n], &q[..n]);
     let (g, dry, dx) = (grid.g_e, grid.dry, grid.dx);
