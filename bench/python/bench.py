@@ -9,7 +9,8 @@ Everything runs in this one process tree, in this order:
   3. Python baselines on a window at the start of each scene: scipy solve_ivp (DOP853, LSODA)
      restarted on every communication interval with the held input, the same model as a
      pythonfmu FMU through fmpy, and TLD.fmu through fmpy (cross-check and fmpy's overhead);
-  4. the report: docs/BENCHMARKS.md, docs/bench/*.png, docs/bench/results.json.
+  4. the shallow-water model's cost against its cells and error (workprec/swe.py);
+  5. the report: docs/BENCHMARKS.md, docs/bench/*.png, docs/bench/results.json.
 
 Error of a run = max over the history of |x - x_ref| / max |x_ref| (x = slosh.x).
 """
@@ -34,6 +35,7 @@ from workprec.native import run_native
 from workprec.plots import plots
 from workprec.report import write_report
 from workprec.sweep import sweep_section, sweep_throughput
+from workprec.swe import swe_cost, swe_section
 
 WORK = REPO / "target" / "bench"
 
@@ -47,6 +49,8 @@ def main():
     ap.add_argument("--only", choices=["study", "study-report"], help="study: measure the design-study "
                     "throughput alone and replace its section of the existing report (about 4 minutes); "
                     "study-report: rewrite that section from the last measurement (bench/study.json)")
+    ap.add_argument("--swe-only", action="store_true", help="only the shallow-water section: "
+                    "print it and write it to target/bench/swe.md (BENCHMARKS.md untouched)")
     args = ap.parse_args()
     from tqdm import tqdm
 
@@ -65,6 +69,12 @@ def main():
     fi.path = Path(args.fmu)
     print(f"FMU {args.fmu} (sha256 {fi.sha256[:16]}), solver items: "
           + ", ".join(f"{n}={v}" for n, v, _ in fi.items("solver")), flush=True)
+    if args.swe_only:
+        section = "\n".join(swe_section(swe_cost(fi, args.quick, WORK)))
+        (WORK / "swe.md").write_text(section)
+        print(section)
+        shutil.rmtree(fi.unzip, ignore_errors=True)
+        return
 
     scenes = make_scenes(args.quick)
     inputs = {}
@@ -122,15 +132,20 @@ def main():
     print("\n".join(sweep_section(sweep_result)), flush=True)
 
     t0 = time.perf_counter()
+    swe_result = swe_cost(fi, args.quick, WORK)
+    timings["shallow water"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
     plots(scenes, rows, img, "")
     timings["report"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     timings["_ref_computed"] = ref_computed
     tgt = write_report(args, scenes, refs, rows, stderr_lines, timings, out / "BENCHMARKS.md", img,
-                       pyfmu_note, fi, xcheck, sweep_section(sweep_result))
+                       pyfmu_note, fi, xcheck,
+                       sweep_section(sweep_result) + swe_section(swe_result))
     clean = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
     (img / "results.json").write_text(json.dumps(dict(
-        timings=timings, targets=tgt, rows=clean,
+        timings=timings, targets=tgt, rows=clean, shallow_water=swe_result,
         scenes=[dict(key=s.key, title=s.title, T=s.T, dts=s.dts, describe=s.describe)
                 for s in scenes], sweep=sweep_result), indent=1, default=str))
     shutil.rmtree(fi.unzip, ignore_errors=True)

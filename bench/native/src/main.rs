@@ -17,11 +17,15 @@
 //! run ID rk4 sub=S [span=abs]                           plain-Rust RK4, S substeps per step
 //!                                                       (span=abs: over (t+dt)-t, diagnostic)
 //! run ID dp45 rtol=TOL                                  plain-Rust Dormand-Prince 5(4)
+//! clock wall|cpu              what the runs below time: the wall clock (default) or the
+//!                             CPU time of the host's thread (not stretched by other
+//!                             processes on a loaded machine)
 //! ```
 //!
 //! Each run is repeated R times on a fresh instance; only the stepping loop is timed
-//! (std::time::Instant around it). Per run it writes DIR/ID.x.f64 (slosh.x at the N+1
-//! communication points; coupled scene also DIR/ID.X.f64, the structure's displacement) and
+//! (std::time::Instant around it, or the thread's CPU time: `clock`). Per run it writes DIR/ID.x.f64 (slosh.x at the N+1
+//! communication points; open-loop scenes also DIR/ID.f.f64, force; coupled scene
+//! DIR/ID.X.f64, the structure's displacement) and
 //! prints `result ID ok N median_ns t1,t2,..` or `result ID fail STEP message`.
 
 mod baseline;
@@ -30,6 +34,49 @@ mod fmu;
 use std::collections::HashMap;
 use std::io::Write;
 use std::time::Instant;
+
+/// What a run's time is measured by.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum Clock {
+    #[default]
+    Wall,
+    /// CPU time of this thread.
+    Cpu,
+}
+
+/// A running stopwatch of `Clock`.
+enum Stopwatch {
+    Wall(Instant),
+    Cpu(u128),
+}
+
+fn thread_cpu_ns() -> u128 {
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes the timespec it is given, which lives across the call.
+    if unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) } != 0 {
+        return 0;
+    }
+    t.tv_sec as u128 * 1_000_000_000 + t.tv_nsec as u128
+}
+
+impl Stopwatch {
+    fn start(clock: Clock) -> Self {
+        match clock {
+            Clock::Wall => Stopwatch::Wall(Instant::now()),
+            Clock::Cpu => Stopwatch::Cpu(thread_cpu_ns()),
+        }
+    }
+
+    fn ns(&self) -> u128 {
+        match self {
+            Stopwatch::Wall(t0) => t0.elapsed().as_nanos(),
+            Stopwatch::Cpu(t0) => thread_cpu_ns().saturating_sub(*t0),
+        }
+    }
+}
 
 use baseline::{Dp45, Model, Rk4};
 
@@ -97,36 +144,49 @@ struct Coupled {
     m0: f64,
 }
 
-/// Open-loop scene: base.a[k] held over step k. Returns (elapsed ns, x history).
-fn run_open<D: Damper>(d: &mut D, a: &[f64], dt: f64) -> Result<(u128, Vec<f64>), (usize, String)> {
+/// Open-loop scene: base.a[k] held over step k. Returns (elapsed ns, x history, force history).
+fn run_open<D: Damper>(d: &mut D, a: &[f64], dt: f64, clock: Clock) -> RunResult {
     let n = a.len();
     let mut xs = vec![0.0; n + 1];
     let mut vs = vec![0.0; n + 1];
     let mut fs = vec![0.0; n + 1];
     let o = d.outputs().map_err(|e| (0, e))?;
     (xs[0], vs[0], fs[0]) = (o[0], o[1], o[2]);
-    let t0 = Instant::now();
+    let t0 = Stopwatch::start(clock);
     for k in 0..n {
         let o = d.step(k as f64 * dt, dt, a[k]).map_err(|e| (k, e))?;
         xs[k + 1] = o[0];
         vs[k + 1] = o[1];
         fs[k + 1] = o[2];
     }
-    let ns = t0.elapsed().as_nanos();
-    std::hint::black_box((&vs, &fs));
-    Ok((ns, xs))
+    let ns = t0.ns();
+    std::hint::black_box(&vs);
+    Ok(Run {
+        ns,
+        x: xs,
+        big_x: vec![],
+        force: fs,
+    })
 }
 
-/// What a timed run gives: (ns in the stepping loop, slosh.x at the communication points,
-/// the structure's X for the coupled scene), or the step it failed at and why.
-type RunResult = Result<(u128, Vec<f64>, Vec<f64>), (usize, String)>;
+/// What a timed run gives: ns in the stepping loop, slosh.x at the communication points, the
+/// structure's X for the coupled scene and force for the open-loop ones (empty otherwise).
+struct Run {
+    ns: u128,
+    x: Vec<f64>,
+    big_x: Vec<f64>,
+    force: Vec<f64>,
+}
+
+/// A run, or the step it failed at and why.
+type RunResult = Result<Run, (usize, String)>;
 
 /// The co-simulation master of the coupled scene (explicit, force held over the step):
 /// at t_k, a_tank = (F_k - C V_k - K X_k)/(M + m0) is given to the damper as base.a, the damper
 /// steps, and the structure is advanced over the same step by RK4 (`sub` substeps) with F_k
 /// held and the ground acceleration evaluated where RK4 needs it. The reference master
 /// (`coupled_master` in python/tld_fmu/scenes.py) performs the same operations in the same order.
-fn run_coupled<D: Damper>(d: &mut D, s: &Coupled, m0: f64, dt: f64) -> RunResult {
+fn run_coupled<D: Damper>(d: &mut D, s: &Coupled, m0: f64, dt: f64, clock: Clock) -> RunResult {
     let n = s.n;
     let mut xs = vec![0.0; n + 1];
     let mut big_x = vec![0.0; n + 1];
@@ -141,7 +201,7 @@ fn run_coupled<D: Damper>(d: &mut D, s: &Coupled, m0: f64, dt: f64) -> RunResult
         // X'' = (F - C V - K X)/(M + m0) - a_g(t),  a_g = -wg^2 Ag sin(wg t)
         (f - s.c * v - s.k * x) / mass + w2a * (s.wg * t).sin()
     };
-    let t0 = Instant::now();
+    let t0 = Stopwatch::start(clock);
     for k in 0..n {
         let t = k as f64 * dt;
         let a_tank = (force - s.c * v - s.k * x) / mass;
@@ -163,8 +223,13 @@ fn run_coupled<D: Damper>(d: &mut D, s: &Coupled, m0: f64, dt: f64) -> RunResult
         xs[k + 1] = o[0];
         big_x[k + 1] = x;
     }
-    let ns = t0.elapsed().as_nanos();
-    Ok((ns, xs, big_x))
+    let ns = t0.ns();
+    Ok(Run {
+        ns,
+        x: xs,
+        big_x,
+        force: vec![],
+    })
 }
 
 fn kv(tokens: &[&str]) -> HashMap<String, String> {
@@ -222,6 +287,7 @@ struct Settings {
     repeats: usize,
     outdir: String,
     model: Option<Model>,
+    clock: Clock,
 }
 
 enum Kind {
@@ -230,7 +296,7 @@ enum Kind {
     Dp45(f64),
 }
 
-/// One repeat of a run: fresh damper, timed loop. Returns (ns, x, X).
+/// One repeat of a run: fresh damper, timed loop.
 fn once(st: &Settings, kind: &Kind) -> RunResult {
     let e0 = |e: String| (0usize, e);
     match kind {
@@ -241,9 +307,9 @@ fn once(st: &Settings, kind: &Kind) -> RunResult {
             match &st.coupled {
                 Some(c) => {
                     let m0 = inst.mass_inactive().map_err(e0)?;
-                    run_coupled(&mut inst, c, m0, st.dt)
+                    run_coupled(&mut inst, c, m0, st.dt, st.clock)
                 }
-                None => run_open(&mut inst, &st.input, st.dt).map(|(ns, x)| (ns, x, vec![])),
+                None => run_open(&mut inst, &st.input, st.dt, st.clock),
             }
         }
         Kind::Rk4(sub, abs_span) => {
@@ -271,8 +337,8 @@ fn once(st: &Settings, kind: &Kind) -> RunResult {
 
 fn go<D: Damper>(d: &mut D, st: &Settings) -> RunResult {
     match &st.coupled {
-        Some(c) => run_coupled(d, c, c.m0, st.dt),
-        None => run_open(d, &st.input, st.dt).map(|(ns, x)| (ns, x, vec![])),
+        Some(c) => run_coupled(d, c, c.m0, st.dt, st.clock),
+        None => run_open(d, &st.input, st.dt, st.clock),
     }
 }
 
@@ -337,6 +403,13 @@ fn real_main(jobfile: &str) -> Result<(), String> {
             "dt" => st.dt = tok[1].parse().map_err(|e| err(format!("{e}")))?,
             "repeats" => st.repeats = tok[1].parse().map_err(|e| err(format!("{e}")))?,
             "outdir" => st.outdir = tok[1].to_string(),
+            "clock" => {
+                st.clock = match tok.get(1).copied() {
+                    Some("wall") => Clock::Wall,
+                    Some("cpu") => Clock::Cpu,
+                    other => return Err(err(format!("clock {other:?}: wall or cpu"))),
+                }
+            }
             "model" => {
                 let m = kv(&tok[1..]);
                 let g = |k: &str| num(&m, k);
@@ -384,14 +457,14 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                     other => return Err(err(format!("unknown run kind {other}"))),
                 };
                 let mut times = Vec::new();
-                let mut first: Option<(Vec<f64>, Vec<f64>)> = None;
+                let mut first: Option<Run> = None;
                 let mut failure = None;
                 for _ in 0..st.repeats.max(1) {
                     match once(&st, &kind) {
-                        Ok((ns, x, big_x)) => {
-                            times.push(ns);
+                        Ok(run) => {
+                            times.push(run.ns);
                             if first.is_none() {
-                                first = Some((x, big_x));
+                                first = Some(run);
                             }
                         }
                         Err((k, e)) => {
@@ -406,10 +479,18 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                         writeln!(out, "result {id} fail {k} {}", e.replace('\n', " ")).ok();
                     }
                     None => {
-                        let (x, big_x) = first.unwrap();
+                        let Some(Run {
+                            x, big_x, force, ..
+                        }) = first
+                        else {
+                            return Err(err("no repeat ran".into()));
+                        };
                         write_f64(&format!("{}/{id}.x.f64", st.outdir), &x).map_err(err)?;
                         if !big_x.is_empty() {
                             write_f64(&format!("{}/{id}.X.f64", st.outdir), &big_x).map_err(err)?;
+                        }
+                        if !force.is_empty() {
+                            write_f64(&format!("{}/{id}.f.f64", st.outdir), &force).map_err(err)?;
                         }
                         let all: Vec<String> = times.iter().map(|t| t.to_string()).collect();
                         let med = median(&mut times.clone());

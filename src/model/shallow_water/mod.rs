@@ -7,7 +7,7 @@
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
 use crate::description::vr;
 use crate::physics::shallow_water::scheme::velocity;
-use crate::physics::shallow_water::{Channel, DRY, Flow};
+use crate::physics::shallow_water::{Channel, DRY, Flow, Scratch};
 use crate::solver::SolveStats;
 use std::f64::consts::PI;
 
@@ -41,6 +41,40 @@ pub struct ShallowWater {
     most: u64,
     /// The liquid of all tanks, rho a b h tanks [kg], as the damper computes mass.liquid.
     liquid: f64,
+    storage: Storage,
+}
+
+/// Where a step is taken (the state stays as it was if the step is refused) and the stages'
+/// storage: allocated once, not per step. It holds nothing from one step to the next: any two
+/// are equal, and a clone is a new one.
+#[derive(Debug)]
+struct Storage {
+    next: Flow,
+    scratch: Scratch,
+}
+
+impl Storage {
+    fn new(channel: &Channel) -> Self {
+        Storage {
+            next: channel.at_rest(),
+            scratch: Scratch::new(channel.cells),
+        }
+    }
+}
+
+impl Clone for Storage {
+    fn clone(&self) -> Self {
+        Storage {
+            next: self.next.clone(),
+            scratch: Scratch::new(self.next.depth.len()),
+        }
+    }
+}
+
+impl PartialEq for Storage {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl ShallowWater {
@@ -121,6 +155,7 @@ impl Model for ShallowWater {
             work: 0.0,
             most: u64::from(p.count(vr::SOLVER_MAX_SUBSTEPS)),
             liquid: common.liquid_mass(),
+            storage: Storage::new(&channel),
         })
     }
 
@@ -132,13 +167,14 @@ impl Model for ShallowWater {
     /// Out of line: the steps of the other models stay small.
     #[inline(never)]
     fn step(&mut self, step: &Interval) -> Result<Stepped, StepError> {
-        let mut flow = self.flow.clone();
+        let Storage { next, scratch } = &mut self.storage;
+        next.clone_from(&self.flow);
         let c = 2.0 * step.zeta * self.omega_1;
         let done = self
             .channel
-            .advance(&mut flow, step.h, &step.base, c, self.most)
+            .advance_in(scratch, next, step.h, &step.base, c, self.most)
             .map_err(|e| StepError::Solver(e.shifted(step.t)))?;
-        self.flow = flow;
+        std::mem::swap(&mut self.flow, next);
         self.zeta = step.zeta;
         self.work += self.scale * done.work;
         let stats = SolveStats {
