@@ -9,7 +9,7 @@ use fmi2_slave::{Context, Refusal, Reply, Status, refuse};
 use super::params::{Source, derived_value, free_real_input, output_of, source_of};
 use super::slave::{TABLE, Tld};
 use super::vars::{VARIABLES, VarType, finite, index_of, vr};
-use crate::model::Output;
+use crate::model::{Damper, Output};
 
 /// Who asks for a value that is no load: the instance's context and the calling function, one
 /// pointer (the out-of-line path then takes all its arguments in registers).
@@ -24,10 +24,10 @@ impl Tld {
     /// reads after every step of a running simulation. None for anything else, which
     /// [`Tld::value_in_full`] answers out of line.
     #[inline(always)]
-    fn loaded(&self, r: u32, ty: VarType) -> Option<f64> {
+    fn loaded(&self, sim: Option<&Damper>, r: u32, ty: VarType) -> Option<f64> {
         match source_of(r, ty) {
             Source::Stored(index) => Some(self.values.at(index)),
-            Source::Output(which) => self.sim.as_ref()?.per_step_output(which),
+            Source::Output(which) => sim?.per_step_output(which),
             _ => None,
         }
     }
@@ -44,8 +44,10 @@ impl Tld {
         function: &str,
         to: fn(f64) -> T,
     ) -> Reply {
+        // Whether the simulation exists is asked once, not per value.
+        let sim = self.sim.as_ref();
         for (slot, &r) in out.iter_mut().zip(vrs) {
-            let value = match self.loaded(r, ty) {
+            let value = match self.loaded(sim, r, ty) {
                 Some(v) => v,
                 None => self.value_in_full(r, ty, &Ask { context, function })?,
             };

@@ -94,8 +94,9 @@ impl Damper {
 
     /// Advance by `h` > 0 from time `t`, the base acceleration following its Taylor polynomial
     /// from `inputs` (held when the derivatives are 0). All or nothing: on error the damper is
-    /// unchanged.
-    #[inline]
+    /// unchanged. Inlined into fmi2DoStep: the models' steps are out of line, and the call
+    /// this would add costs more than its body.
+    #[inline(always)]
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
         // Only a tracked amplitude moves the damping; a fixed one was applied in configure.
         match &self.tracker {

@@ -38,14 +38,18 @@ fn guard<S: Slave>(
     let Some(inst) = (unsafe { Instance::<S>::from_ptr(c) }) else {
         return Status::Error as fmi2Status;
     };
+    // The usual outcome, carried out with nothing to say, is told apart inside: a bare None
+    // leaves the closure, not the whole reply.
     let outcome = catch_unwind(AssertUnwindSafe(|| {
-        inst.require(call)?;
-        body(inst)
+        match inst.require(call).and_then(|()| body(inst)) {
+            Ok(Status::Ok) if !inst.logs_calls() => None,
+            reply => Some(reply),
+        }
     }));
     // Every arm takes its value: nothing is left to drop on the way out.
     match outcome {
-        Ok(Ok(Status::Ok)) if !inst.logs_calls() => Status::Ok as fmi2Status,
-        Ok(reply) => report(inst, call, reply),
+        Ok(None) => Status::Ok as fmi2Status,
+        Ok(Some(reply)) => report(inst, call, reply),
         Err(panic) => broken(inst, call, panic),
     }
 }
