@@ -3,7 +3,11 @@
  *   leak_host <path to TLD.so> <GUID> <cycles>
  *
  * Each cycle instantiates, initialises, steps, saves/serialises/restores the FMU state, makes a
- * few refused calls (so the error and logging paths run too), terminates and frees. Afterwards it
+ * few refused calls (so the error and logging paths run too), terminates and frees. With
+ * -DVR_CYCLE=vr -DCYCLE_N=n, cycle k first sets the Integer parameter vr to 1 + k % n (TLD.fmu:
+ * every model in turn; Building.fmu: 1 to 20 storeys), so every configuration's allocations are
+ * checked; -DVR_EXTRA=vr -DEXTRA_VALUE=v sets one more Integer parameter in every cycle (TLD.fmu:
+ * 16 shallow-water cells, enough to allocate everything and cheap under valgrind). Afterwards it
  * measures the heap one initialised instance holds, from 1000 live instances at once.
  * Exit status 0 = all calls returned the expected status. */
 #include <dlfcn.h>
@@ -56,6 +60,7 @@ typedef int (*fmi2FreeFMUstate_t)(comp_t, void **);
 typedef int (*fmi2SerializedFMUstateSize_t)(comp_t, void *, size_t *);
 typedef int (*fmi2SerializeFMUstate_t)(comp_t, void *, char *, size_t);
 typedef int (*fmi2DeSerializeFMUstate_t)(comp_t, const char *, size_t, void **);
+typedef int (*fmi2SetInteger_t)(comp_t, const unsigned *, size_t, const int *);
 
 #define CHECK(call, want) do { int s_ = (call); if (s_ != (want)) { \
     fprintf(stderr, "%s returned %d, expected %d (cycle %d)\n", #call, s_, (want), cycle); return 1; } } while (0)
@@ -70,7 +75,8 @@ int main(int argc, char **argv) {
     LOAD(fmi2EnterInitializationMode) LOAD(fmi2ExitInitializationMode) LOAD(fmi2Terminate)
     LOAD(fmi2SetReal) LOAD(fmi2GetReal) LOAD(fmi2DoStep) LOAD(fmi2GetFMUstate) LOAD(fmi2SetFMUstate)
     LOAD(fmi2FreeFMUstate) LOAD(fmi2SerializedFMUstateSize) LOAD(fmi2SerializeFMUstate)
-    LOAD(fmi2DeSerializeFMUstate)
+    LOAD(fmi2DeSerializeFMUstate) LOAD(fmi2SetInteger)
+    (void)fmi2SetInteger;
     callbacks_t cb = { logger, NULL, NULL, NULL, NULL };
     /* Value references from modelDescription.xml, passed in by scripts/leakcheck. */
     const unsigned base_a = VR_BASE_A, slosh_x = VR_SLOSH_X, eta = VR_ETA, unknown = 9999;
@@ -83,6 +89,16 @@ int main(int argc, char **argv) {
         CHECK(fmi2EnterInitializationMode(c), 0);
         double e = 2.5;
         CHECK(fmi2SetReal(c, &eta, 1, &e), 0);
+#if defined(VR_CYCLE) && defined(CYCLE_N)
+        const unsigned selector = VR_CYCLE;
+        const int choice = 1 + cycle % CYCLE_N;
+        CHECK(fmi2SetInteger(c, &selector, 1, &choice), 0);
+#endif
+#if defined(VR_EXTRA) && defined(EXTRA_VALUE)
+        const unsigned extra = VR_EXTRA;
+        const int extra_value = EXTRA_VALUE;
+        CHECK(fmi2SetInteger(c, &extra, 1, &extra_value), 0);
+#endif
         CHECK(fmi2ExitInitializationMode(c), 0);
         double t = 0.0, h = 0.01;
         void *state = NULL;
