@@ -79,6 +79,7 @@ impl Stopwatch {
 }
 
 use baseline::{Dp45, Model, Rk4};
+use fmi2_host::Value;
 
 /// Something that advances the sloshing over one communication step with base.a held and
 /// returns (slosh.x, slosh.v, force) at its end.
@@ -277,7 +278,7 @@ fn median(v: &mut [u128]) -> u128 {
 
 #[derive(Default)]
 struct Settings {
-    lib: Option<fmu::Library>,
+    lib: Option<fmi2_host::Library>,
     lib_path: String,
     guid: String,
     vrs: Option<fmu::Vrs>,
@@ -291,7 +292,7 @@ struct Settings {
 }
 
 enum Kind {
-    Fmu(Vec<fmu::Param>),
+    Fmu(Vec<(u32, Value)>),
     Rk4(u32, bool),
     Dp45(f64),
 }
@@ -424,7 +425,7 @@ fn real_main(jobfile: &str) -> Result<(), String> {
             }
             "run" => {
                 if st.lib.is_none() && tok[2] == "fmu" {
-                    st.lib = Some(fmu::Library::load(&st.lib_path, &st.guid).map_err(err)?);
+                    st.lib = Some(fmu::load(&st.lib_path, &st.guid).map_err(err)?);
                 }
                 let id = tok[1];
                 let m = kv(&tok[3..]);
@@ -435,17 +436,18 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                             let (head, val) = t.split_once('=').ok_or(err(format!("bad {t}")))?;
                             let (ty, vr) = head.split_once(':').ok_or(err(format!("bad {t}")))?;
                             let vr: u32 = vr.parse().map_err(|e| err(format!("{t}: {e}")))?;
-                            params.push(match ty {
-                                "R" => fmu::Param::Real(
-                                    vr,
-                                    val.parse().map_err(|e| err(format!("{t}: {e}")))?,
-                                ),
-                                "I" => fmu::Param::Integer(
-                                    vr,
-                                    val.parse().map_err(|e| err(format!("{t}: {e}")))?,
-                                ),
-                                _ => return Err(err(format!("bad type in {t}"))),
-                            });
+                            params.push((
+                                vr,
+                                match ty {
+                                    "R" => Value::Real(
+                                        val.parse().map_err(|e| err(format!("{t}: {e}")))?,
+                                    ),
+                                    "I" => Value::Integer(
+                                        val.parse().map_err(|e| err(format!("{t}: {e}")))?,
+                                    ),
+                                    _ => return Err(err(format!("bad type in {t}"))),
+                                },
+                            ));
                         }
                         Kind::Fmu(params)
                     }
