@@ -23,8 +23,7 @@ struct Load {
     vr: Vrs,
 }
 
-/// The loaded library and its instances (the pool is declared first: dropped before the
-/// library it calls into).
+/// The loaded library and its instances (each keeps its binary loaded while it lives).
 #[derive(Default)]
 pub struct Server {
     pool: Pool,
