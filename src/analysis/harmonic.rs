@@ -304,9 +304,12 @@ mod tests {
         }
         let peak = hb.peak(10.0).expect("peak").x;
         // Below A one (high) frequency, A itself the degenerate quadratic, then two up to the peak.
+        // Just above A (a = 1 - A^2/X^2 = 2e-9) the small root needs the stable form of the
+        // quadratic formula: the textbook one loses b^2 / (4 a c) ~ 5e8 of its precision.
         for (x, count) in [
             (0.001, 1),
             (0.002, 1),
+            (0.002 * (1.0 + 1e-9), 2),
             (0.003, 2),
             (0.02, 2),
             (0.99 * peak, 2),
