@@ -63,6 +63,30 @@ mod tests {
         assert!((linearised_variance(&law, c, d) / want - 1.0).abs() < 1e-12);
     }
 
+    /// Guards the quadrature's range: for the linear oscillator the exact variance is
+    /// D_n / (2 c w_f^2) whatever the parameters, so over natural frequencies of 0.5-1000
+    /// rad/s, damping ratios of 0.001-0.5 and intensities of 1e-10-10 (sigma from 2e-10 to
+    /// 141 m, 2c/D_n from 2e-4 to 2e13) the integral must reach past the density's e^-700 and keep
+    /// its step a small fraction of sigma. Simpson's rule on a Gaussian with steps of
+    /// ~1e-3 sigma is exact to rounding: 1e-9 allowed, as in the case above.
+    #[test]
+    fn exact_variance_of_the_linear_oscillator_over_a_range_of_parameters() {
+        for wf in [0.5, 5.0, 100.0, 1000.0] {
+            for zeta in [0.001, 0.05, 0.5] {
+                for d in [1e-10, 1e-2, 10.0] {
+                    let law = PowerLaw::new(wf, 0.0, 2.0, 0.25);
+                    let c = 2.0 * zeta * wf;
+                    let want = d / (2.0 * c * wf * wf);
+                    let (vx, _) = exact_variances(&law, c, d);
+                    assert!(
+                        (vx / want - 1.0).abs() < 1e-9,
+                        "w_f {wf} zeta {zeta} D {d}: {vx:e} vs {want:e}"
+                    );
+                }
+            }
+        }
+    }
+
     /// Statistical linearisation is only approximate (MODEL.md section 4): it takes x as
     /// Gaussian, whereas the exact density exp(-(2c/D_n) U(x)) of the module's header is not, and
     /// departs further from one the faster U grows, i.e. the larger eta. Hence the looser bound
