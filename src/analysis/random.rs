@@ -68,7 +68,9 @@ mod tests {
     /// rad/s, damping ratios of 0.001-0.5 and intensities of 1e-10-10 (sigma from 2e-10 to
     /// 141 m, 2c/D_n from 2e-4 to 2e13) the integral must reach past the density's e^-700 and keep
     /// its step a small fraction of sigma. Simpson's rule on a Gaussian with steps of
-    /// ~1e-3 sigma is exact to rounding: 1e-9 allowed, as in the case above.
+    /// ~1e-3 sigma is exact to rounding: 1e-9 allowed, as in the case above. The velocity
+    /// variance D_n / (2c) is one division, and statistical linearisation is exact for the
+    /// linear law: its bisection ends at the last bit of sigma, 1e-12 allowed for sigma^2.
     #[test]
     fn exact_variance_of_the_linear_oscillator_over_a_range_of_parameters() {
         for wf in [0.5, 5.0, 100.0, 1000.0] {
@@ -77,10 +79,13 @@ mod tests {
                     let law = PowerLaw::new(wf, 0.0, 2.0, 0.25);
                     let c = 2.0 * zeta * wf;
                     let want = d / (2.0 * c * wf * wf);
-                    let (vx, _) = exact_variances(&law, c, d);
+                    let (vx, vv) = exact_variances(&law, c, d);
+                    let lin = linearised_variance(&law, c, d);
                     assert!(
-                        (vx / want - 1.0).abs() < 1e-9,
-                        "w_f {wf} zeta {zeta} D {d}: {vx:e} vs {want:e}"
+                        (vx / want - 1.0).abs() < 1e-9
+                            && (vv / (d / (2.0 * c)) - 1.0).abs() < 1e-15
+                            && (lin / want - 1.0).abs() < 1e-12,
+                        "w_f {wf} zeta {zeta} D {d}: {vx:e} {vv:e} {lin:e} vs {want:e}"
                     );
                 }
             }
