@@ -210,6 +210,79 @@ mod tests {
         );
     }
 
+    /// Runs `nelder_mead` from the simplex (1, 2), (2, 2), (1, 3) (start (1, 2), steps (1, 1))
+    /// on a function given by a table of exact values (10 anywhere else) and returns the
+    /// first `n` points it evaluates. With f = 0, 1, 2 at the three corners, the centroid of
+    /// the best two is c = (1.5, 2) and the points along the worst's line are the reflection
+    /// r = (2, 1), the expansion e = (2.5, 0) and the inside contraction k = (1.25, 2.5), all
+    /// exact in binary.
+    fn first_evaluations(table: &[([f64; 2], f64)], n: usize) -> Vec<[f64; 2]> {
+        let seen = std::cell::RefCell::new(Vec::new());
+        let corners = [([1.0, 2.0], 0.0), ([2.0, 2.0], 1.0), ([1.0, 3.0], 2.0)];
+        let f = |q: [f64; 2]| {
+            seen.borrow_mut().push(q);
+            corners
+                .iter()
+                .chain(table)
+                .find(|(p, _)| *p == q)
+                .map_or(10.0, |&(_, v)| v)
+        };
+        nelder_mead(f, [1.0, 2.0], [1.0, 1.0]);
+        seen.into_inner().into_iter().take(n).collect()
+    }
+
+    /// Guards the decisions of `nelder_mead` against the standard rules (Lagarias, Reeds,
+    /// Wright & Wright 1998, with the inside contraction only), worked by hand on exact values:
+    /// expand iff f(r) < f(best), keep the expansion iff f(e) < f(r), accept the reflection iff
+    /// f(best) <= f(r) < f(middle), else contract, keep the contraction iff f(k) < f(worst),
+    /// else shrink the other two halfway to the best. Ties go to the rule's side of `<`; the
+    /// next point evaluated shows which branch ran.
+    #[test]
+    fn nelder_mead_takes_the_standard_step_at_each_branch_and_tie() {
+        let (r, e, k) = ([2.0, 1.0], [2.5, 0.0], [1.25, 2.5]);
+        let start = vec![[1.0, 2.0], [2.0, 2.0], [1.0, 3.0]];
+        let then = |more: &[[f64; 2]]| [start.clone(), more.to_vec()].concat();
+        // f(r) = f(best): a reflection, no expansion; the next simplex (1, 2), (2, 1), (2, 2)
+        // reflects (2, 2) through (1.5, 1.5) to (1, 1).
+        assert_eq!(first_evaluations(&[(r, 0.0)], 5), then(&[r, [1.0, 1.0]]));
+        // f(e) = f(r) < f(best): the reflection is kept; (2, 1), (1, 2), (2, 2) next gives (1, 1).
+        assert_eq!(
+            first_evaluations(&[(r, -1.0), (e, -1.0)], 6),
+            then(&[r, e, [1.0, 1.0]])
+        );
+        // f(best) < f(r) < f(middle): the reflection, as in the first case.
+        assert_eq!(first_evaluations(&[(r, 0.5)], 5), then(&[r, [1.0, 1.0]]));
+        // f(r) = f(middle): a contraction.
+        assert_eq!(first_evaluations(&[(r, 1.0), (k, 0.5)], 5), then(&[r, k]));
+        // f(k) < f(worst): the contraction is kept; (1, 2), (2, 2), (1.25, 2.5) next reflects
+        // (1.25, 2.5) through (1.5, 2) to (1.75, 1.5).
+        assert_eq!(
+            first_evaluations(&[(r, 3.0), (k, 1.5)], 6),
+            then(&[r, k, [1.75, 1.5]])
+        );
+        // f(k) = f(worst): a shrink, (2, 2) and (1, 3) halfway to (1, 2).
+        assert_eq!(
+            first_evaluations(&[(r, 3.0), (k, 2.0)], 7),
+            then(&[r, k, [1.5, 2.0], [1.0, 2.5]])
+        );
+    }
+
+    /// Guards the stopping test of `nelder_mead`: on a constant the three values agree, so it
+    /// stops after evaluating the first simplex and returns the start.
+    #[test]
+    fn nelder_mead_stops_at_once_on_a_constant() {
+        let count = std::cell::Cell::new(0);
+        let q = nelder_mead(
+            |_| {
+                count.set(count.get() + 1);
+                1.0
+            },
+            [1.0, 2.0],
+            [1.0, 1.0],
+        );
+        assert_eq!((q, count.get()), ([1.0, 2.0], 3));
+    }
+
     /// Guards `kappa_model` on the linear law (phi = 0): the peak of the base-excited
     /// response w^2 A / |w_f^2 - w^2 + i D w| lies at w^2 = w_f^2 / (1 - 2 zeta^2), whatever
     /// Lambda. The peak's frequency is the mean of the two merging roots, within ~eps of the

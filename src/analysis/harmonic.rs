@@ -304,9 +304,12 @@ mod tests {
         }
         let peak = hb.peak(10.0).expect("peak").x;
         // Below A one (high) frequency, A itself the degenerate quadratic, then two up to the peak.
+        // Just above A (a = 1 - A^2/X^2 = 2e-9) the small root needs the stable form of the
+        // quadratic formula: the textbook one loses b^2 / (4 a c) ~ 5e8 of its precision.
         for (x, count) in [
             (0.001, 1),
             (0.002, 1),
+            (0.002 * (1.0 + 1e-9), 2),
             (0.003, 2),
             (0.02, 2),
             (0.99 * peak, 2),
@@ -374,6 +377,52 @@ mod tests {
             "{near:?} {peak:?}"
         );
         assert!(hb.frequencies(peak.x * (1.0 + 1e-9)).is_empty());
+    }
+
+    /// Guards `fold` against the fold solved another way: it is the lowest point of the high
+    /// root s = w^2 of P(s, X) = a s^2 + b s + c (a = 1 - A^2/X^2, b = D^2 - 2K, c = K^2),
+    /// so P = 0 and, as P_s ds/dX + P_X = 0, P_X = a' s^2 + b' s + c' = 0 there. For eta = 2
+    /// K = w_f^2 + (3/4) k3 X^2 (see `duffing_backbone_is_the_first_order_formula`), and
+    /// Newton's method on (P, P_X) with the exact derivatives converges to the last bits.
+    /// Over several base amplitudes the fold lies in either neighbour cell of the search's
+    /// grid minimum. The golden section ends where w_high no longer changes in its last
+    /// bits, X within ~sqrt(eps) ~ 1e-8 relative of the minimum: 1e-6 allowed; w_high is flat
+    /// there, so the frequency is right to ~1e-14: 1e-12 allowed.
+    #[test]
+    fn fold_is_the_lowest_point_of_the_high_branch() {
+        let (wf, phi, len) = (5.6389f64, 1.0, 0.25f64);
+        let k3 = wf * wf * phi * (2.0 / len).powi(2);
+        for amp in [0.002, 0.0025, 0.003, 0.0035, 0.004] {
+            let hb = HarmonicBalance {
+                base_amplitude: amp,
+                ..example()
+            };
+            let d2 = hb.damping * hb.damping;
+            let fold = hb.fold(1.0).expect("fold");
+            let (mut x, mut s) = (fold.x, fold.w * fold.w);
+            for _ in 0..50 {
+                let (k, k1, k2) = (wf * wf + 0.75 * k3 * x * x, 1.5 * k3 * x, 1.5 * k3);
+                let (a, a1, a2) = (
+                    1.0 - (amp / x).powi(2),
+                    2.0 * amp * amp / x.powi(3),
+                    -6.0 * amp * amp / x.powi(4),
+                );
+                let (b, b1, b2) = (d2 - 2.0 * k, -2.0 * k1, -2.0 * k2);
+                let (c, c1, c2) = (k * k, 2.0 * k * k1, 2.0 * (k1 * k1 + k * k2));
+                let p = a * s * s + b * s + c;
+                let q = a1 * s * s + b1 * s + c1;
+                let (p_x, p_s) = (q, 2.0 * a * s + b);
+                let (q_x, q_s) = (a2 * s * s + b2 * s + c2, 2.0 * a1 * s + b1);
+                let det = p_x * q_s - p_s * q_x;
+                x -= (p * q_s - p_s * q) / det;
+                s -= (p_x * q - p * q_x) / det;
+            }
+            assert!(
+                (fold.x / x - 1.0).abs() < 1e-6 && (fold.w / s.sqrt() - 1.0).abs() < 1e-12,
+                "A {amp}: {fold:?} vs X {x}, w {}",
+                s.sqrt()
+            );
+        }
     }
 
     /// Guards the stability flags of `curve`: a periodic solution is stable where the

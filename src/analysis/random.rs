@@ -63,6 +63,36 @@ mod tests {
         assert!((linearised_variance(&law, c, d) / want - 1.0).abs() < 1e-12);
     }
 
+    /// Guards the quadrature's range: for the linear oscillator the exact variance is
+    /// D_n / (2 c w_f^2) whatever the parameters, so over natural frequencies of 0.5-1e5
+    /// rad/s (far past any tank: the integral must not depend on the scales), damping ratios of
+    /// 0.001-0.5 and intensities of 1e-10-10 (sigma from 2e-13 to 141 m, 2c/D_n from 2e-4 to
+    /// 2e15) the integral must reach past the density's e^-700 and keep
+    /// its step a small fraction of sigma. Simpson's rule on a Gaussian with steps of
+    /// ~1e-3 sigma is exact to rounding: 1e-9 allowed, as in the case above. The velocity
+    /// variance D_n / (2c) is one division, and statistical linearisation is exact for the
+    /// linear law: its bisection ends at the last bit of sigma, 1e-12 allowed for sigma^2.
+    #[test]
+    fn exact_variance_of_the_linear_oscillator_over_a_range_of_parameters() {
+        for wf in [0.5, 5.0, 100.0, 1000.0, 1e5] {
+            for zeta in [0.001, 0.05, 0.5] {
+                for d in [1e-10, 1e-2, 10.0] {
+                    let law = PowerLaw::new(wf, 0.0, 2.0, 0.25);
+                    let c = 2.0 * zeta * wf;
+                    let want = d / (2.0 * c * wf * wf);
+                    let (vx, vv) = exact_variances(&law, c, d);
+                    let lin = linearised_variance(&law, c, d);
+                    assert!(
+                        (vx / want - 1.0).abs() < 1e-9
+                            && (vv / (d / (2.0 * c)) - 1.0).abs() < 1e-15
+                            && (lin / want - 1.0).abs() < 1e-12,
+                        "w_f {wf} zeta {zeta} D {d}: {vx:e} {vv:e} {lin:e} vs {want:e}"
+                    );
+                }
+            }
+        }
+    }
+
     /// Statistical linearisation is only approximate (MODEL.md section 4): it takes x as
     /// Gaussian, whereas the exact density exp(-(2c/D_n) U(x)) of the module's header is not, and
     /// departs further from one the faster U grows, i.e. the larger eta. Hence the looser bound

@@ -370,6 +370,73 @@ fn grazes_under_a_ramp_are_not_stepped_over() {
     // Steps of 2.5-4.1 s in a tank of 40 m, where h |a1| exceeds h + |a1|: a bound that
     // added where it should multiply would be too small only there.
     graze_under(40.0, [0.5, 4.0, 0.0], 2.0, 2.5);
+    // And under a2 = 8 in a tank of 400 m (the mass falls 80 m after the graze): h |a2|
+    // exceeds h + |a2| from h = 8/7 on.
+    graze_under(400.0, [0.5, 2.0, 8.0], 2.0, 2.5);
+}
+
+/// Guards the impact search of a flight that starts late in a long step (s0 of 2.9 s, steps
+/// of 6.2-8.8 s): its samples must cover s1 - s0, not s1 / s0 (shorter there). Under a held
+/// a_b = 0.1 m/s^2 in a tank of d = 0.45 m with e = 0.9, the mass thrown up from the centre
+/// hits the +wall, falls onto the -wall at t2 and rebounds with u = sqrt(2 a (d + delta)), so
+/// that it passes the +wall by delta, for 1.05 r, r = 0.01 d / (u + a (h - t2)) the promise
+/// of that search (as in `grazes_of_the_wall_are_not_stepped_over`). Every flight is a
+/// parabola: the impact times and the state at the step's end are closed forms.
+#[test]
+fn grazes_after_impacts_late_in_long_steps_are_not_stepped_over() {
+    let (accel, d, e) = (0.1, 0.45, 0.9);
+    let m = Slamming {
+        clearance: d,
+        restitution: e,
+        rest_speed: 1e-6,
+    };
+    let half = d / 2.0;
+    // Nominal times (delta = 0), for r only.
+    let u_nominal = (2.0 * accel * d).sqrt();
+    let t2_nominal = {
+        let w = u_nominal / e;
+        let ev = (w * w - 2.0 * accel * d).sqrt();
+        let v = ev / e;
+        ((v * v + accel * d).sqrt() - v + w - ev) / accel
+    };
+    for i in 0..40 {
+        let h = 6.2 + 0.065 * f64::from(i);
+        let r = 0.01 * d / (u_nominal + accel * (h - t2_nominal));
+        let delta = accel * (0.525 * r).powi(2) / 2.0;
+        // Backwards from the rebound at the -wall: it hit at w, after falling from the
+        // +wall, which it left at e v, having hit it at v on the way up from the centre.
+        let u = (2.0 * accel * (d + delta)).sqrt();
+        let w = u / e;
+        let ev = (w * w - 2.0 * accel * d).sqrt();
+        let v = ev / e;
+        let v_start = (v * v + accel * d).sqrt();
+        let t2 = (v_start - v + w - ev) / accel;
+        // Up from the -wall: half + delta - a (t - t_peak)^2 / 2 = half at the graze.
+        let v_graze = (2.0 * accel * delta).sqrt();
+        let t_graze = t2 + (u - v_graze) / accel;
+        assert!(t_graze < h && h - t_graze < (2.0 * d / accel).sqrt());
+        let mut st = SlamState {
+            v: v_start,
+            ..Default::default()
+        };
+        m.advance(&mut st, h, &BaseAcceleration::held(accel))
+            .expect("step");
+        assert_eq!(
+            st.impacts, 3,
+            "h {h}: the graze by {delta:e} m was missed: {st:?}"
+        );
+        let (z, v) = quartic([accel, 0.0, 0.0], half, -e * v_graze, h - t_graze);
+        // The rebound u carries the rounding of three flights and two impacts, in the model
+        // and in the closed forms (where w^2 - 2 a d cancels to a fifth): up to ~5 ulps, so
+        // the peak moves by u du / a = 2 d du / u ~ 1.1e-15 d, the graze's time by that over
+        // v_graze, and the state at the end by up to (|v| + a) ~ 0.5 times that:
+        // 1e-15 d / v_graze allows twice the estimate.
+        let tol = 1e-15 * d / v_graze;
+        assert!(
+            (st.z - z).abs() < tol && (st.v - v).abs() < tol,
+            "h {h}: {st:?} vs {z} {v}, {tol:e}"
+        );
+    }
 }
 
 /// One case of `grazes_under_a_ramp_are_not_stepped_over`: clearance d, input a, peak at
