@@ -80,7 +80,7 @@ impl Slamming {
         // Between impacts |z| <= d/2 and the trajectory is a polynomial of degree <= 4 whose
         // curvature is bounded by the base acceleration: sample finely enough that it cannot leave
         // and return between samples unnoticed, then bisect the first sign change.
-        let amax = b.a[0].abs() + (s1 - s0) * (b.a[1].abs() + (s1 - s0) * b.a[2].abs());
+        let amax = acceleration_bound(b, s0, s1);
         let vmax = v0.abs() + amax * (s1 - s0);
         let resolution = if vmax > 0.0 {
             0.01 * self.clearance / vmax
@@ -199,6 +199,13 @@ impl Slamming {
         *st = next;
         Ok(impulse)
     }
+}
+
+/// A bound of abs(a_b) over [s0, s1]: the polynomial is about b.t0, so its terms grow with the
+/// distance from t0, which for a search starting after an impact is more than s1 - s0.
+fn acceleration_bound(b: &BaseAcceleration, s0: f64, s1: f64) -> f64 {
+    let reach = (s0 - b.t0).abs().max((s1 - b.t0).abs());
+    b.a[0].abs() + reach * (b.a[1].abs() + reach * b.a[2].abs())
 }
 
 #[cfg(test)]

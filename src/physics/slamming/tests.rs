@@ -521,3 +521,30 @@ fn chattering_under_weak_and_strong_pressing_ends_at_rest() {
         }
     }
 }
+
+/// The impact search's bound of abs(a_b) holds over any interval of the step, also one that
+/// starts after an impact, where the polynomial about the step's start has grown (a_b = 4 s^2
+/// searched over [3, 3.5]: at most 49, which the interval's length alone, 0.5, would put at 2).
+#[test]
+fn the_acceleration_bound_holds_anywhere_in_the_step() {
+    let cases = [
+        ([0.0, 0.0, 8.0], 3.0, 3.5),
+        ([1.0, -2.0, 0.5], 0.0, 2.0),
+        ([-0.3, 5.0, -7.0], 1.25, 1.5),
+        ([2.0, 0.0, 0.0], 4.0, 9.0),
+    ];
+    for (a, s0, s1) in cases {
+        let b = BaseAcceleration { t0: 0.0, a };
+        let bound = acceleration_bound(&b, s0, s1);
+        let largest = (0..=1000)
+            .map(|k| b.at(s0 + (s1 - s0) * f64::from(k) / 1000.0).abs())
+            .fold(0.0f64, f64::max);
+        assert!(
+            largest <= bound,
+            "{a:?} on [{s0}, {s1}]: {largest} > {bound}"
+        );
+        // Not looser than the terms' own sizes at the far end.
+        let far = s1.abs().max(s0.abs());
+        assert!(bound <= a[0].abs() + far * (a[1].abs() + far * a[2].abs()) + 1e-12);
+    }
+}
