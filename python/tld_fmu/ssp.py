@@ -540,7 +540,8 @@ def system_ground(ssp_path: Path, omega: float = 0.0, amplitude: float = 0.0):
     through ground.a (harmonic_ground here; continuous, where the hosts hold ground.a over the
     step)."""
     from . import building
-    grounds = [building.harmonic_ground(*reversed(built_in_ground(ssp_path)))]
+    built_in_amplitude, built_in_omega = built_in_ground(ssp_path)
+    grounds = [building.harmonic_ground(built_in_omega, built_in_amplitude)]
     if amplitude:
         grounds.append(harmonic_ground(omega, amplitude))
     return sum_grounds(*grounds)
