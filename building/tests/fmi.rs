@@ -149,17 +149,20 @@ fn serialised_states_continue_bit_for_bit_elsewhere() {
     );
 }
 
-/// Output derivatives agree with central differences of the outputs over a ramped input.
+/// Output derivatives agree with central differences of the outputs over a ramped input, on
+/// top of the built-in ground motion.
 #[test]
 fn output_derivatives_are_the_outputs_slopes() {
     let mut inst = Instance::new("rates");
-    inst.initialise(&three_storeys());
+    let mut params = three_storeys();
+    params.extend([(vr::GROUND_AMPLITUDE, 0.01), (vr::GROUND_OMEGA, 6.0)]);
+    inst.initialise(&params);
     for _ in 0..40 {
         let t = inst.time;
         inst.set_real(vr::GROUND_A, 0.8 * (4.0 * t).sin());
         inst.do_step(0.01);
     }
-    let (slope, force_rate, dt) = (0.3, 40.0, 1e-4);
+    let (slope, force_rate, dt) = (0.3, 40.0, 1e-5);
     let outputs = [vr::TLD_A, vr::TLD_V, vr::TLD_X, vr::ROOF_X, vr::BASE_SHEAR];
     let sample = |inst: &mut Instance, k: f64| {
         inst.set_real(vr::GROUND_A, slope * k * dt);
@@ -264,5 +267,67 @@ fn one_long_step_equals_two_short_ones_for_polynomial_inputs() {
             split[k]
         );
         assert!(whole[k].abs() > 1e-6, "the run must move: {}", whole[k]);
+    }
+}
+
+/// One storey under the built-in ground motion x_g = A sin(w t) alone: the whole response from
+/// rest relative to the ground (transient and steady state), in closed form, whatever the
+/// step. m u'' + c u' + k u = m A w^2 sin(w t), u(0) = u'(0) = 0; the absolute outputs add the
+/// ground's motion (tld.x = x_g + u, tld.v = A w cos(w t) + u') and floor[1].a = -(c u' + k u)/m.
+#[test]
+fn one_storey_built_in_ground_motion_is_the_closed_form() {
+    let (m, k, zeta, amp, w) = (168.0_f64, 5342.0_f64, 0.02, 1e-3, 5.0);
+    let mut inst = Instance::new("harmonic");
+    let mut params = ONE_STOREY.to_vec();
+    params.extend([
+        (vr::DAMPING_ZETA, zeta),
+        (vr::GROUND_AMPLITUDE, amp),
+        (vr::GROUND_OMEGA, w),
+    ]);
+    inst.initialise(&params);
+    let wn = (k / m).sqrt();
+    let c = 2.0 * zeta * wn * m;
+    let wd = wn * (1.0 - zeta * zeta).sqrt();
+    // particular P sin + Q cos, then the free motion that starts u, u' at 0
+    let (f, d) = (m * amp * w * w, (k - m * w * w).powi(2) + (c * w).powi(2));
+    let (p, q) = (f * (k - m * w * w) / d, -f * c * w / d);
+    let (c1, s) = (-q, zeta * wn);
+    let c2 = (s * c1 - p * w) / wd;
+    let exact = |t: f64| {
+        let e = (-s * t).exp();
+        let (cd, sd) = ((wd * t).cos(), (wd * t).sin());
+        let u = p * (w * t).sin() + q * (w * t).cos() + e * (c1 * cd + c2 * sd);
+        let v = p * w * (w * t).cos() - q * w * (w * t).sin()
+            + e * ((c2 * wd - s * c1) * cd - (c1 * wd + s * c2) * sd);
+        [
+            u,
+            amp * (w * t).sin() + u,
+            amp * w * (w * t).cos() + v,
+            -(c * v + k * u) / m,
+        ]
+    };
+    let outputs = [vr::FLOOR_1__X, vr::TLD_X, vr::TLD_V, vr::FLOOR_1__A];
+    let mut worst = [0.0_f64; 4];
+    let mut peak = [0.0_f64; 4];
+    // at t = 0 the ground moves, the building stands
+    let start = outputs.map(|r| inst.get_real(r));
+    assert_eq!(start, [0.0, 0.0, amp * w, 0.0]);
+    for (n, h) in [(370, 0.013), (40, 0.21), (1000, 0.001), (300, 0.05)] {
+        for _ in 0..n {
+            assert_eq!(inst.do_step(h), OK);
+            let want = exact(inst.time);
+            for (j, &r) in outputs.iter().enumerate() {
+                worst[j] = worst[j].max((inst.get_real(r) - want[j]).abs());
+                peak[j] = peak[j].max(want[j].abs());
+            }
+        }
+    }
+    for j in 0..4 {
+        let rel = worst[j] / peak[j];
+        eprintln!(
+            "output {}: {rel:.1e} of its peak {:.4e}",
+            outputs[j], peak[j]
+        );
+        assert!(rel < 1e-11, "output {}: {rel:e} of its peak", outputs[j]);
     }
 }

@@ -1,9 +1,13 @@
-//! Building.fmu's saved-state layout is pinned: a state of format version 1 (tag "BLDs") is
+//! Building.fmu's saved-state layout is pinned: a state of format version 2 (tag "BLDs") is
 //! committed under building/tests/golden/. A run that reaches the same point must serialise to
 //! exactly those bytes, and the committed bytes, restored into a new instance, must continue
 //! exactly as the uninterrupted run. Regenerate with `BUILDING_BLESS=1 cargo test -p
 //! building-fmu --test golden_state` only with a new format version or a deliberate change of
 //! the numbers, and say so in the commit.
+//!
+//! Version 2 (2026-11-24) added the built-in ground motion's oscillator to the state
+//! (ground.amplitude, ground.omega; the run below uses it beside ground.a); the version 1 file
+//! stays, and is refused by name.
 //!
 //! The inputs are built from + and * only; the matrix exponential is nalgebra's (Pade, scaling
 //! and squaring), so the bytes are those of this platform (x86_64 Linux).
@@ -47,20 +51,22 @@ fn configured(name: &str) -> Instance {
         (vr::DAMPING_ZETA1, 0.02),
         (vr::DAMPING_ZETA2, 0.03),
         (vr::STOREY_1__STIFFNESS + 2, 4000.0),
+        (vr::GROUND_AMPLITUDE, 0.004),
+        (vr::GROUND_OMEGA, 6.5),
     ]);
     inst
 }
 
 #[test]
-fn version_1_state_is_pinned_and_continues_bit_for_bit() {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden/state-v1.bin");
+fn version_2_state_is_pinned_and_continues_bit_for_bit() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden/state-v2.bin");
     let mut run = configured("golden-run");
     drive(&mut run, 0, BEFORE);
     let bytes = run.serialised();
     if std::env::var_os("BUILDING_BLESS").is_some() {
         std::fs::write(&path, &bytes).expect("write the golden state");
     }
-    let golden = std::fs::read(&path).expect("building/tests/golden/state-v1.bin");
+    let golden = std::fs::read(&path).expect("building/tests/golden/state-v2.bin");
     assert_eq!(&golden[..4], b"BLDs");
     assert_eq!(bytes, golden, "the saved state's bytes changed");
     let mut restored = Instance::new("golden-restored");
@@ -75,4 +81,19 @@ fn version_1_state_is_pinned_and_continues_bit_for_bit() {
             "{r}"
         );
     }
+}
+
+/// A version 1 state (before the built-in ground motion) is refused, saying why, and the
+/// instance is left as it was.
+#[test]
+fn version_1_state_is_refused_by_its_version() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden/state-v1.bin");
+    let old = std::fs::read(&path).expect("building/tests/golden/state-v1.bin");
+    let mut inst = configured("golden-v1");
+    drive(&mut inst, 0, 3);
+    let before = inst.get_real(vr::ROOF_X);
+    assert_ne!(inst.restore(&old), OK);
+    let logs = inst.logs().join("\n");
+    assert!(logs.contains("version 1 is not supported"), "{logs}");
+    assert_eq!(inst.get_real(vr::ROOF_X).to_bits(), before.to_bits());
 }

@@ -12,9 +12,13 @@ parameter: the liquid moving rigidly with the tanks) goes into Building's `tld.m
 in Building.ssv, computed here by instantiating TLD.fmu with the system's TLD parameters: a
 parameter-to-parameter connection is not something the hosts evaluate before initialisation.
 
-Building.fmu's `ground.a` is left unconnected: the ground motion is the system's input, set by
-the host each step (Building.fmu has no built-in excitation; an unconnected input keeps its
-start value 0, so the default experiment alone leaves the system at rest).
+Each system shakes itself: Building.ssv sets Building.fmu's built-in harmonic ground motion
+(`ground.amplitude` A, `ground.omega` w: x_g = A sin(w t), exact within Building's step), so a
+host that opens the archive and runs its default experiment, setting nothing, gets the damped
+response (Table 2.1: 1 mm at w = w_s, the structure's resonance; the 3-storey building: the
+example's 0.2 mm at its first mode with the damper's inactive liquid, Building's
+mode[1].omega). Building.fmu's `ground.a` is left unconnected: a host may set it each step,
+and that ground acceleration is ADDED to the built-in motion.
 
 Everything named in the archive is read from the two FMUs' modelDescriptions (variable names,
 types, units, the Integer aliases of Enumerations), so the archive cannot drift from the FMUs;
@@ -22,10 +26,14 @@ the .ssd and .ssv are validated against the SSP 1.0 schemas that fmpy ships.
 
 The systems are described like the configurations of tld_fmu.building ({"building": {"masses",
 "stiffnesses", "rayleigh"}, "dampers": [{"floor", "tanks", "params"}]}), with exactly one damper
-(Building.fmu carries one): `table21()` (the seed's Table 2.1 structure, tld_fmu.sdof) and the
-example 3-storey building of scripts/examples/building.toml.
+(Building.fmu carries one), plus "ground": {"amplitude" [m], "omega" [rad/s], or None: the
+building's first mode with the damper's inactive mass}, the built-in motion: `table21()` (the
+seed's Table 2.1 structure, tld_fmu.sdof) and the example 3-storey building of
+scripts/examples/building.toml.
 
-Hosts (each returns {"Component.variable": array over the communication points t_0..t_n}):
+Hosts (tld_fmu.ssp_hosts, also importable from here; each runs `steps` steps of h, sets
+Building.ground.a before step k to ground_a[k] if given, else not at all, and returns
+{"Component.variable": array over t_0..t_n}):
 `run_libcosim` (libcosimpy: CosimExecution.from_ssp_file), `run_ecos` (ecospy: EcosSimulation
 with ssp_path), `run_fmpy` (fmpy.ssp: its SSD reader and its Jacobi step over the components).
 All three are Jacobi masters with inputs held over the step: every component steps from t_k with
@@ -34,10 +42,10 @@ clocks.
 
     .venv/bin/python -m tld_fmu.ssp                       # write systems/*.ssp from target/fmu
     .venv/bin/python -m tld_fmu.ssp run systems/tld_table21.ssp [--host libcosim ...] [--csv F]
+                                                          # the default experiment, nothing set
 """
 from __future__ import annotations
 
-import ctypes
 import math
 import sys
 import tempfile
@@ -50,6 +58,7 @@ import numpy as np
 
 from .contract import Contract
 from .paths import BUILDING_FMU, FMU, REPO
+from .ssp_hosts import HOSTS, load_tbb, run_ecos, run_fmpy, run_libcosim  # noqa: F401  (the hosts, here too)
 
 SSD_NS = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC_NS = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -79,18 +88,25 @@ EXTRA_CONNECTORS = {"Building": ["ground.a", "roof.x", "base_shear"],
                     "TLD": ["slosh.x", "force.mean", "energy.dissipated"]}
 
 
+# Table 2.1's built-in ground motion: 1 mm, the README's demo amplitude, at w_s
+TABLE21_GROUND_AMPLITUDE = 1e-3
+
+
 def table21():
     """The seed's Table 2.1 structure (tld_fmu.sdof: M, zeta, w_s) as a 1-storey building with one
-    25 cm tank at TLD.fmu's defaults on its floor."""
-    from .sdof import K_S, M_S, ZETA_S
+    25 cm tank at TLD.fmu's defaults on its floor, shaken at w_s by 1 mm."""
+    from .sdof import K_S, M_S, W_S, ZETA_S
     return {"building": {"masses": [M_S], "stiffnesses": [K_S], "rayleigh": [ZETA_S, ZETA_S]},
-            "dampers": [{"floor": 1, "tanks": 1, "params": {}}]}
+            "dampers": [{"floor": 1, "tanks": 1, "params": {}}],
+            "ground": {"amplitude": TABLE21_GROUND_AMPLITUDE, "omega": W_S}}
 
 
 def building_example():
-    """The example 3-storey building of scripts/examples/building.toml (its building and damper)."""
+    """The example 3-storey building of scripts/examples/building.toml (its building and damper),
+    shaken by the example's ground amplitude at its first mode (with the damper's inactive mass)."""
     cfg = tomllib.loads(BUILDING_EXAMPLE.read_text())
-    return {"building": cfg["building"], "dampers": cfg["dampers"]}
+    return {"building": cfg["building"], "dampers": cfg["dampers"],
+            "ground": {"amplitude": cfg["load"]["ground_amplitude"], "omega": None}}
 
 
 # name of the archive in systems/ -> (description, configuration, default experiment (stop, step))
@@ -148,6 +164,19 @@ def inactive_mass(tld_fmu: Path, params: dict) -> float:
             fmu.freeInstance()
 
 
+def ground_motion(cfg, tld_mass: float) -> tuple[float, float]:
+    """(amplitude [m], omega [rad/s]) of the system's built-in ground motion ((0, 0): none); an
+    omega of None is the building's first mode with the damper's inactive mass on its floor."""
+    g = cfg.get("ground")
+    if not g:
+        return 0.0, 0.0
+    omega = g.get("omega")
+    if omega is None:
+        from .building import structure
+        omega = structure(cfg, [(int(_one_damper(cfg)["floor"]) - 1, tld_mass)]).omega1
+    return float(g["amplitude"]), float(omega)
+
+
 def building_parameters(cfg, building: Contract, tld_mass: float) -> dict:
     """Building.fmu's parameter values of the system {name: value}."""
     b = cfg["building"]
@@ -162,6 +191,9 @@ def building_parameters(cfg, building: Contract, tld_mass: float) -> dict:
     for i, (m, k) in enumerate(zip(masses, stiffnesses), start=1):
         out[f"storey[{i}].mass"], out[f"storey[{i}].stiffness"] = m, k
     out["tld.mass"] = tld_mass
+    amplitude, omega = ground_motion(cfg, tld_mass)
+    if amplitude:
+        out["ground.amplitude"], out["ground.omega"] = amplitude, omega
     for name in out:
         building.variable(name)   # every name exists in Building.fmu
     return out
@@ -259,7 +291,7 @@ def ssd(name: str, description: str, contracts: dict, stop: float, step: float) 
             f'<ssd:SystemStructureDescription xmlns:ssd="{SSD_NS}" xmlns:ssc="{SSC_NS}" '
             f'xmlns:ssv="{SSV_NS}" xmlns:osp="{OSP_NS}" name={quoteattr(name)} version="1.0" '
             'generationTool="tld-fmu python/tld_fmu/ssp.py">\n'
-            f'  <ssd:System name="{SYSTEM}" description={quoteattr(description + ". Building.ground.a (ground acceleration, m/s2) is the input the host sets each step.")}>\n'
+            f'  <ssd:System name="{SYSTEM}" description={quoteattr(description + ". Building.fmu moves the ground itself (ground.amplitude, ground.omega in Building.ssv); Building.ground.a (m/s2), if a host sets it, adds to that motion.")}>\n'
             '    <ssd:Elements>\n' + "\n".join(comps) + '\n    </ssd:Elements>\n'
             '    <ssd:Connections>\n' + "\n".join(conns) + '\n    </ssd:Connections>\n'
             '  </ssd:System>\n'
@@ -325,154 +357,61 @@ def read(ssp: Path, member: str) -> str:
         return z.read(member).decode()
 
 
-# -- hosts ----------------------------------------------------------------------------------------
-
-def _columns(outputs):
-    return [tuple(o.split(".", 1)) for o in outputs]
-
-
-def run_libcosim(ssp: Path, h: float, ground_a, outputs) -> dict:
-    """libcosim (libcosimpy): the archive as libcosim loads it (CosimExecution.from_ssp_file, a
-    fixed-step execution of step h, integer nanoseconds), ground.a through an override
-    manipulator before each step, the outputs from a last-value observer. ground_a[k] is held
-    over step k; returns the outputs at t_0..t_n."""
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimManipulator import CosimManipulator
-    from libcosimpy.CosimObserver import CosimObserver
-    log_output_level(CosimLogLevel.WARNING)
-    ex = CosimExecution.from_ssp_file(str(Path(ssp).resolve()), round(h * 1e9))
-    index = {s.name.decode(): s.index for s in ex.slave_infos()}
-    vr = {name: {v.name.decode(): v.reference for v in ex.slave_variables(i)} for name, i in index.items()}
-    man, obs = CosimManipulator.create_override(), CosimObserver.create_last_value()
-    ex.add_manipulator(man)
-    ex.add_observer(obs)
-    cols = _columns(outputs)
-    n = len(ground_a)
-    res = np.empty((n + 1, len(cols)))
-    g = index["Building"], [vr["Building"]["ground.a"]]
-
-    def read(k):
-        for j, (c, v) in enumerate(cols):
-            res[k, j] = obs.last_real_values(index[c], [vr[c][v]])[0]
-    for k in range(n):
-        man.slave_real_values(g[0], g[1], [float(ground_a[k])])
-        ex.step(1)
-        if k == 0:
-            # the observer sees values after the first step only: t_0 is the state at rest
-            res[0] = 0.0
-        read(k + 1)
-    return {o: res[:, j] for j, o in enumerate(outputs)}
-
-
-def load_tbb():
-    """Load libecosc.so's libtbb.so.12 (before importing ecospy): from the pinned `tbb` wheel
-    (<venv>/lib), else the system's."""
-    here = Path(sys.prefix) / "lib" / "libtbb.so.12"
-    try:
-        ctypes.CDLL(str(here) if here.is_file() else "libtbb.so.12", mode=ctypes.RTLD_GLOBAL)
-    except OSError as e:
-        raise RuntimeError(f"ecospy's libecosc.so needs libtbb.so.12: pip install tbb "
-                           f"(pinned in scripts/requirements.txt) ({e})") from e
-
-
-def run_ecos(ssp: Path, h: float, ground_a, outputs) -> dict:
-    """Ecos (ecospy): EcosSimulation from the archive, ground.a set between steps (Ecos passes it
-    on right before the next fmi2DoStep), outputs read after each step. Needs `unzip` on PATH."""
-    load_tbb()
-    from ecospy import EcosSimulation
-    sim = EcosSimulation(ssp_path=str(Path(ssp).resolve()), step_size=h)
-    try:
-        sim.init(parameter_set=PARAMETER_SET)   # Ecos applies no set unless named
-        ident = [f"{c}::{v}" for c, v in _columns(outputs)]
-        n = len(ground_a)
-        res = np.empty((n + 1, len(ident)))
-        res[0] = [sim.get_real(i) for i in ident]
-        for k in range(n):
-            sim.set_real("Building::ground.a", float(ground_a[k]))
-            sim.step()
-            res[k + 1] = [sim.get_real(i) for i in ident]
-    finally:
-        sim.terminate()
-        sim.free()
-    return {o: res[:, j] for j, o in enumerate(outputs)}
-
-
-def run_fmpy(ssp: Path, h: float, ground_a, outputs) -> dict:
-    """fmpy's SSP support (fmpy.ssp): its reader of the archive (schema-validated), its
-    instantiation of the components and its Jacobi step `do_step` (set the inputs from the
-    connectors, fmi2DoStep, get the outputs), the connections applied after every step as
-    fmpy.ssp.simulate_ssp does. Two things simulate_ssp itself does not do are done here: it
-    applies no ParameterBinding of the SSD (only a parameter set passed to it), so each
-    component's .ssv is handed to it with the component's name prefixed; and it takes inputs
-    only on system connectors, one step late, so ground.a is set on Building's connector."""
-    from fmpy.ssp.simulation import do_step, free_fmu, instantiate_fmu
-    from fmpy.ssp.ssd import ParameterSet, find_components, find_connectors, read_ssd
-    from fmpy import extract
-    ssd_ = read_ssd(str(ssp))
-    components = {c.name: c for c in find_components(ssd_.system)}
-    for c in find_connectors(ssd_.system):
-        c.value = 0.0
-    conn = {(c.parent.name, c.name): c for comp in components.values() for c in comp.connectors}
-    # the SSD's connections as (start, end) connectors (fmpy.ssp.ssd.get_connections would wire
-    # the unconnected input ground.a to the source of the input listed before it)
-    connections = [(conn[(c.startElement, c.startConnector)], conn[(c.endElement, c.endConnector)])
-                   for c in ssd_.system.connections]
-    tmp = extract(str(ssp))
-    try:
-        for comp in components.values():
-            comp.parent = ssd_.system   # set by read_ssd; the prefix of set_parameters
-            params = ParameterSet(name=comp.name)
-            for binding in comp.parameterBindings:
-                for pset in binding.parameterValues:
-                    for p in pset.parameters:
-                        p.name = f"{comp.name}.{p.name}"
-                        params.parameters.append(p)
-            instantiate_fmu(comp, tmp, 0.0, None, params)
-        ground = conn[("Building", "ground.a")]
-        cols = _columns(outputs)
-        n = len(ground_a)
-        res = np.empty((n + 1, len(cols)))
-
-        def read(k):
-            from fmpy.ssp.simulation import get_value
-            res[k] = [get_value(components[c], v) for c, v in cols]
-        read(0)
-        t = 0.0
-        for k in range(n):
-            ground.value = float(ground_a[k])
-            for comp in components.values():
-                do_step(comp, t, h)
-            for start, end in connections:
-                end.value = start.value
-            t = (k + 1) * h
-            read(k + 1)
-        for comp in components.values():
-            free_fmu(comp)
-    finally:
-        import shutil
-        shutil.rmtree(tmp, ignore_errors=True)
-    return {o: res[:, j] for j, o in enumerate(outputs)}
-
-
-HOSTS = {"libcosim": run_libcosim, "Ecos": run_ecos, "fmpy": run_fmpy}
+def default_experiment(ssp: Path) -> tuple[float, float]:
+    """(stop time, step) of an archive's default experiment (the step from its OSP annotation)."""
+    from lxml import etree
+    doc = etree.fromstring(read(ssp, "SystemStructure.ssd").encode())
+    exp = doc.find(f"{{{SSD_NS}}}DefaultExperiment")
+    algo = exp.find(f".//{{{OSP_NS}}}FixedStepAlgorithm")
+    return float(exp.get("stopTime")), float(algo.get("baseStepSize"))
 
 
 def harmonic_ground(w: float, amplitude: float):
     """Ground motion with x_g = amplitude (1 - cos w t) (at rest displaced by 0 at t = 0, zero-mean
     velocity: what Building.fmu integrates from ground.a from rest) as ground(t) -> (a_g, v_g,
-    x_g), the form tld_fmu.building.simulate takes."""
+    x_g), the form tld_fmu.building.simulate takes: the motion a host adds through ground.a."""
     return lambda t: (amplitude * w * w * math.cos(w * t), amplitude * w * math.sin(w * t),
                       amplitude * (1 - math.cos(w * t)))
 
 
+def built_in_ground(ssp_path: Path) -> tuple[float, float]:
+    """(amplitude [m], omega [rad/s]) of the built-in ground motion an archive's Building.ssv
+    sets ((0, 0): none), read back from the archive."""
+    from lxml import etree
+    doc = etree.fromstring(read(ssp_path, "resources/Building.ssv").encode())
+    value = {p.get("name"): float(p[0].get("value")) for p in doc.iter(f"{{{SSV_NS}}}Parameter")}
+    return value.get("ground.amplitude", 0.0), value.get("ground.omega", 0.0)
+
+
+def sum_grounds(*grounds):
+    """The sum of ground motions ground(t) -> (a_g, v_g, x_g)."""
+    return lambda t: tuple(sum(c) for c in zip(*(g(t) for g in grounds)))
+
+
+def system_ground(ssp_path: Path, omega: float = 0.0, amplitude: float = 0.0):
+    """The ground motion of a run of the archive as ground(t) -> (a_g, v_g, x_g): its built-in
+    motion A sin(w t) (tld_fmu.building.harmonic_ground) plus, if amplitude, what the host adds
+    through ground.a (harmonic_ground here; continuous, where the hosts hold ground.a over the
+    step)."""
+    from . import building
+    built_in_amplitude, built_in_omega = built_in_ground(ssp_path)
+    grounds = [building.harmonic_ground(built_in_omega, built_in_amplitude)]
+    if amplitude:
+        grounds.append(harmonic_ground(omega, amplitude))
+    return sum_grounds(*grounds)
+
+
 def run(ssp_path: Path, hosts, omega: float, amplitude: float, duration: float, h: float,
         outputs=("Building.roof.x", "Building.base_shear", "TLD.force", "TLD.slosh.x")) -> dict:
-    """Run an archive in each of `hosts` under the ground motion x_g = amplitude (1 - cos omega t)
-    (ground.a held over each step of h); {host: {output: array at t_0..t_n}}."""
-    g = harmonic_ground(omega, amplitude)
-    a = [g(k * h)[0] for k in range(int(round(duration / h)))]
-    return {host: HOSTS[host](ssp_path, h, a, list(outputs)) for host in hosts}
+    """Run an archive in each of `hosts` for `duration`: its built-in ground motion, plus, if
+    amplitude, the ground motion x_g = amplitude (1 - cos omega t) set on ground.a (held over
+    each step of h); {host: {output: array at t_0..t_n}}."""
+    steps = int(round(duration / h))
+    a = None
+    if amplitude:
+        g = harmonic_ground(omega, amplitude)
+        a = [g(k * h)[0] for k in range(steps)]
+    return {host: HOSTS[host](ssp_path, h, steps, list(outputs), a) for host in hosts}
 
 
 def main(argv=None):
@@ -484,15 +423,18 @@ def main(argv=None):
     w = sub.add_parser("write", help="write the archives (the default)")
     w.add_argument("--out", default=str(SYSTEMS_DIR))
     w.add_argument("names", nargs="*", default=list(SYSTEMS), choices=[[]] + list(SYSTEMS))
-    r = sub.add_parser("run", help="run an archive under harmonic ground motion in SSP hosts and compare them")
+    r = sub.add_parser("run", help="run an archive (its built-in ground motion, plus harmonic ground.a if "
+                                   "--amplitude) in SSP hosts and compare them")
     r.add_argument("ssp")
     r.add_argument("--host", action="append", choices=list(HOSTS),
                    help="libcosim, Ecos or fmpy (repeatable; default: all three)")
-    r.add_argument("--omega", type=float, default=5.6, help="ground motion frequency [rad/s] (5.6)")
-    r.add_argument("--amplitude", type=float, default=1e-4,
-                   help="ground displacement amplitude A [m]: x_g = A (1 - cos w t) (1e-4)")
-    r.add_argument("--duration", type=float, default=60.0, help="[s] (60)")
-    r.add_argument("--step", type=float, default=0.01, help="communication step [s] (0.01)")
+    r.add_argument("--omega", type=float, default=5.6,
+                   help="frequency of the motion added through ground.a [rad/s] (5.6)")
+    r.add_argument("--amplitude", type=float, default=0.0,
+                   help="ground displacement amplitude A [m] added through ground.a: x_g = A (1 - cos w t) "
+                        "(0: none, the archive's built-in motion alone)")
+    r.add_argument("--duration", type=float, help="[s] (the default experiment's stop time)")
+    r.add_argument("--step", type=float, help="communication step [s] (the default experiment's)")
     r.add_argument("--csv", help="write the first host's time histories to this CSV file")
     args = ap.parse_args(argv)
     if args.cmd != "run":
@@ -505,10 +447,15 @@ def main(argv=None):
         import shutil
         if not shutil.which("unzip"):
             sys.exit("Ecos unpacks the FMUs with the system `unzip`: install it (apt-get install unzip)")
+    stop, step = default_experiment(Path(args.ssp))
+    args.duration = stop if args.duration is None else args.duration
+    args.step = step if args.step is None else args.step
     runs = run(Path(args.ssp), hosts, args.omega, args.amplitude, args.duration, args.step)
     first = runs[hosts[0]]
     n = len(next(iter(first.values()))) - 1
-    print(f"{args.ssp}: {n} steps of {args.step} s, x_g = {args.amplitude:g} (1 - cos {args.omega:g} t) m")
+    a_b, w_b = built_in_ground(Path(args.ssp))
+    added = f" + ground.a: x_g = {args.amplitude:g} (1 - cos {args.omega:g} t) m" if args.amplitude else ""
+    print(f"{args.ssp}: {n} steps of {args.step} s, built-in x_g = {a_b:g} sin({w_b:.6g} t) m{added}")
     for host, res in runs.items():
         print(f"  {host:9s} " + ", ".join(f"max|{o}| = {np.max(np.abs(v)):.9g}" for o, v in res.items()))
     for host in hosts[1:]:

@@ -7,6 +7,9 @@ scipy, and
   large that any integration of the FMU's own would show;
 - a 1-storey harmonic steady state against its closed form, a 3-storey one against the complex
   frequency response (modal superposition), after the transient has died out;
+- the built-in ground motion (ground.amplitude, ground.omega): exact at any step, the limit of
+  the same motion through ground.a with derivatives (third order), the absolute outputs the
+  ground's whole motion; a 1-storey steady state against the closed-form transmissibility;
 - the declared modes and damping against scipy's generalised eigenproblem;
 - fmpy's validate_fmu (the compliance checkers run on both FMUs in test_compliance.py).
 """
@@ -37,7 +40,8 @@ def building(building_path):
 class Run:
     """One initialised Building.fmu instance."""
 
-    def __init__(self, building, masses, stiffnesses, zeta, tld_mass=0.0, floor=0):
+    def __init__(self, building, masses, stiffnesses, zeta, tld_mass=0.0, floor=0, ground=(0.0, 0.0)):
+        """ground: (ground.amplitude, ground.omega), the built-in motion."""
         from fmpy.fmi2 import FMU2Slave
         md, d, self.vr = building
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=d, modelIdentifier="Building",
@@ -49,20 +53,24 @@ class Run:
         self.fmu.setInteger([self.vr["storeys"], self.vr["tld.floor"]], [n, floor])
         names = [f"storey[{i + 1}].mass" for i in range(n)] + \
                 [f"storey[{i + 1}].stiffness" for i in range(n)] + ["damping.zeta", "tld.mass"]
-        self.fmu.setReal([self.vr[k] for k in names], list(masses) + list(stiffnesses) + [zeta, tld_mass])
+        names += ["ground.amplitude", "ground.omega"]
+        self.fmu.setReal([self.vr[k] for k in names],
+                         list(masses) + list(stiffnesses) + [zeta, tld_mass] + list(ground))
         self.fmu.exitInitializationMode()
         self.n, self.t = n, 0.0
 
     def get(self, *names):
         return self.fmu.getReal([self.vr[k] for k in names])
 
-    def step(self, h, inputs, rates=None):
-        """inputs/rates: {name: value}; rates are order-1 input derivatives over the step."""
+    def step(self, h, inputs, rates=None, rates2=None):
+        """inputs/rates/rates2: {name: value}; rates, rates2 are order-1 and order-2 input
+        derivatives over the step."""
         self.fmu.setReal([self.vr[k] for k in inputs], list(inputs.values()))
-        if rates:
-            names = list(rates)
-            self.fmu.setRealInputDerivatives([self.vr[k] for k in names], [1] * len(names),
-                                             list(rates.values()))
+        for order, r in ((1, rates), (2, rates2)):
+            if r:
+                names = list(r)
+                self.fmu.setRealInputDerivatives([self.vr[k] for k in names], [order] * len(names),
+                                                 list(r.values()))
         self.fmu.doStep(self.t, h)
         self.t += h
 
@@ -193,6 +201,81 @@ def test_one_storey_harmonic_steady_state_is_the_closed_form(building):
     want = A / np.sqrt((w ** 2 - wf ** 2) ** 2 + (2 * zeta * w * wf) ** 2)
     got = 0.5 * (max(xs) - min(xs))
     assert abs(got - want) / want < 1e-4, (got, want)
+
+
+BUILT_IN = ["floor[1].x", "floor[2].x", "roof.x", "base_shear", "tld.a", "floor[1].a", "tld.v", "tld.x"]
+
+
+def built_in_history(building, h, t_end, ground, through_input):
+    """THREE under the ground displacement A sin(w t), ground = (A, w): built in, or (through_input)
+    as ground.a = -A w^2 sin(w t) with its first and second derivatives at each step's start.
+    The outputs BUILT_IN at every time t_end / 20."""
+    A, w = ground
+    run = Run(building, **THREE, ground=(0.0, 0.0) if through_input else ground)
+    every = int(round(t_end / h / 20))
+    rows = []
+    for j in range(int(round(t_end / h))):
+        t = j * h
+        if through_input:
+            run.step(h, {"ground.a": -A * w * w * np.sin(w * t)}, {"ground.a": -A * w ** 3 * np.cos(w * t)},
+                     {"ground.a": A * w ** 4 * np.sin(w * t)})
+        else:
+            run.step(h, {})
+        if (j + 1) % every == 0:
+            rows.append(run.get(*BUILT_IN))
+    run.close()
+    return np.array(rows), np.arange(1, len(rows) + 1) * every * h
+
+
+def test_built_in_ground_motion_is_exact_and_what_ground_a_converges_to(building):
+    """The built-in motion is exact at any step (h and h/5 agree to round-off), and the same
+    motion fed through ground.a with derivatives (a quadratic over each step, where the sine
+    is not one) converges to it at third order. The relative motion and the absolute
+    accelerations agree; the absolute velocity and displacement differ by the ground's start:
+    the built-in ground moves at A w from t = 0, ground.a's ground starts at rest (tld.v differs
+    by A w, tld.x by A w t)."""
+    _, _, _, w, _ = matrices(**THREE)
+    ground = (2e-3, 0.93 * w[0])
+    A, wg = ground
+    t_end = 4.0
+    exact = {h: built_in_history(building, h, t_end, ground, False) for h in (0.05, 0.01)}
+    (b1, t), (b2, _) = exact[0.05], exact[0.01]
+    scale = np.abs(b1).max(axis=0)
+    assert np.all(scale > 0)
+    step_free = (np.abs(b1 - b2).max(axis=0) / scale).max()
+    assert step_free < 1e-12, f"the built-in motion depends on the step: {step_free:.2e}"
+    err = {}
+    for h in (0.05, 0.025):
+        g, _ = built_in_history(building, h, t_end, ground, True)
+        g[:, BUILT_IN.index("tld.v")] += A * wg
+        g[:, BUILT_IN.index("tld.x")] += A * wg * t
+        err[h] = (np.abs(g - b1).max(axis=0) / scale).max()
+    ratio = err[0.05] / err[0.025]
+    print(f"\nbuilt-in vs ground.a with derivatives: {err[0.05]:.2e} at h = 0.05, {err[0.025]:.2e} at "
+          f"0.025 (ratio {ratio:.2f}); built-in at h = 0.05 vs 0.01: {step_free:.1e}")
+    assert 7.0 < ratio < 9.0, f"third order expected (8), got {ratio:.2f}"
+    assert err[0.05] < (wg * 0.05) ** 3
+
+
+def test_one_storey_built_in_steady_state_is_the_transmissibility(building):
+    """One storey under the built-in x_g = A sin(w t): after the transient, the absolute
+    displacement tld.x has the amplitude A sqrt((k^2 + (c w)^2) / ((k - m w^2)^2 + (c w)^2))
+    and the relative one A m w^2 / sqrt((k - m w^2)^2 + (c w)^2)."""
+    m, k, zeta, A, wf = 168.0, 5342.0, 0.05, 1e-3, 4.0
+    run = Run(building, [m], [k], zeta, ground=(A, wf))
+    h, T = 0.01, 80.0
+    rows = []
+    for _ in range(int(T / h)):
+        run.step(h, {})
+        if run.t > T - 2 * np.pi / wf:
+            rows.append(run.get("tld.x", "floor[1].x"))
+    run.close()
+    rows = np.array(rows)
+    c = 2 * zeta * np.sqrt(k * m)
+    d = np.sqrt((k - m * wf ** 2) ** 2 + (c * wf) ** 2)
+    want = [A * np.sqrt(k ** 2 + (c * wf) ** 2) / d, A * m * wf ** 2 / d]
+    got = 0.5 * (rows.max(axis=0) - rows.min(axis=0))
+    np.testing.assert_allclose(got, want, rtol=1e-4)
 
 
 def test_three_storey_harmonic_steady_state_is_the_frequency_response(building):

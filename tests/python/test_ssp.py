@@ -1,10 +1,14 @@
 """The coupled systems as SSP archives (python/tld_fmu/ssp.py, systems/*.ssp): standard-conformant,
 built from the FMUs, and the same numbers in every SSP host that installs here.
 
-Scene: the ground moves x_g = A (1 - cos w t) near the first mode (ground.a = A w^2 cos(w t_k)
-held over step k, set by each host on Building.ground.a, the system's one free input), 0.01 s
-steps for 10 s. Compared: Building's roof.x and base_shear, TLD's force and slosh.x at every
-communication point.
+Scenes, 0.01 s steps for 10 s:
+- the archive as it opens: nothing set by the host, Building.fmu's built-in ground motion
+  (Building.ssv: x_g = A sin(w t), Table 2.1 1 mm at w_s, the 3-storey building 0.2 mm at its
+  first mode) shakes the system;
+- the same plus ground motion the host adds: x_g = A (1 - cos w t) near the first mode
+  (ground.a = A w^2 cos(w t_k) held over step k, set by each host on Building.ground.a, the
+  system's one free input).
+Compared: Building's roof.x and base_shear, TLD's force and slosh.x at every communication point.
 
 - libcosim (libcosimpy), Ecos (ecospy) and fmpy.ssp load the archive themselves (components,
   connections, parameter sets) and are all Jacobi masters with held inputs: every component
@@ -75,10 +79,13 @@ def rel(a, b):
 _RUNS = {}
 
 
-def run(host, path, h=H, t_end=T_END, scale=1.0):
-    key = (host, str(path), h, t_end, scale)
+def run(host, path, h=H, t_end=T_END, scale=1.0, added=True):
+    """A host's run of an archive: its built-in ground motion, plus (added) the harmonic ground.a."""
+    key = (host, str(path), h, t_end, scale, added)
     if key not in _RUNS:
-        _RUNS[key] = ssp.HOSTS[host](path, h, ground_a(h, t_end, scale), OUTPUTS + ["Building.mode[1].omega"])
+        steps = int(round(t_end / h))
+        _RUNS[key] = ssp.HOSTS[host](path, h, steps, OUTPUTS + ["Building.mode[1].omega"],
+                                     ground_a(h, t_end, scale) if added else None)
     return _RUNS[key]
 
 
@@ -148,11 +155,28 @@ def test_every_host_applies_the_parameters(archives, fmu_path, name):
         assert abs(got[-1] - want) < 1e-12 * want, f"{host}: omega_1 {got[-1]} vs {want}"
 
 
+def test_the_archives_shake_their_building(archives, fmu_path):
+    """Building.ssv sets the built-in ground motion: Table 2.1 1 mm at w_s (its resonance), the
+    3-storey building the example's amplitude at its first mode (Building's mode[1].omega, with
+    the damper's inactive liquid, as the hosts report it)."""
+    from tld_fmu.sdof import W_S
+    assert ssp.built_in_ground(archives["tld_table21"]) == (ssp.TABLE21_GROUND_AMPLITUDE, W_S)
+    amplitude, omega = ssp.built_in_ground(archives["tld_building"])
+    assert amplitude == ssp.building_example()["ground"]["amplitude"] > 0
+    for host in ssp.HOSTS:
+        w1 = run(host, archives["tld_building"], added=False)["Building.mode[1].omega"][-1]
+        assert abs(omega - w1) < 1e-12 * w1, (host, omega, w1)
+
+
+@pytest.mark.parametrize("added", [False, True], ids=["as_opened", "with_ground.a"])
 @pytest.mark.parametrize("name", list(ssp.SYSTEMS))
-def test_hosts_agree(archives, name):
-    runs = {host: run(host, archives[name]) for host in ssp.HOSTS}
+def test_hosts_agree(archives, name, added):
+    """As opened (no input set: the built-in ground motion alone) and with ground.a added."""
+    runs = {host: run(host, archives[name], added=added) for host in ssp.HOSTS}
     roof = runs["fmpy"]["Building.roof.x"]
-    assert np.max(np.abs(roof)) > 1e-4, "the ground motion does not reach the building"
+    amplitude, _ = ssp.built_in_ground(archives[name])
+    # near resonance the roof moves more than the ground
+    assert np.max(np.abs(roof)) > amplitude, "the ground motion does not reach the building"
     hosts = list(runs)
     lines = []
     for i, a in enumerate(hosts):
@@ -160,7 +184,8 @@ def test_hosts_agree(archives, name):
             worst = max(rel(runs[a][o], runs[b][o]) for o in OUTPUTS)
             lines.append(f"{a} vs {b}: {worst:.2e}")
             assert worst < RTOL, f"{name}: {a} vs {b} differ by {worst:.3g}"
-    print(f"\n{name}, {len(roof) - 1} steps of {H} s, max relative difference: " + "; ".join(lines))
+    print(f"\n{name}, {'with' if added else 'without'} ground.a, {len(roof) - 1} steps of {H} s, "
+          f"max|roof.x| {np.max(np.abs(roof)):.4g} m, max relative difference: " + "; ".join(lines))
 
 
 def test_the_comparison_tells_a_1ppm_change_apart(archives):
@@ -169,22 +194,26 @@ def test_the_comparison_tells_a_1ppm_change_apart(archives):
     assert min(rel(b[o], a[o]) for o in OUTPUTS) > 100 * RTOL
 
 
+@pytest.mark.parametrize("added", [False, True], ids=["as_opened", "with_ground.a"])
 @pytest.mark.parametrize("name", list(ssp.SYSTEMS))
-def test_building_py_agrees_at_the_coupling_order(archives, fmu_path, name):
+def test_building_py_agrees_at_the_coupling_order(archives, fmu_path, name, added):
     """scripts/building.py's master on the same system (tld_fmu.building.simulate, Gauss-Seidel
     with force.mean, RK4) against the hosts (Jacobi, exact building step): the difference is
-    first order in the step (halves when the step halves), of the size of w h."""
+    first order in the step (halves when the step halves), of the size of w h. The ground
+    motion given to building.py is the archive's built-in one, read back from Building.ssv
+    (tld_fmu.building.harmonic_ground), plus the one the hosts add through ground.a."""
     from fmpy import extract, read_model_description
     cfg = ssp.SYSTEMS[name][1]()
     md = read_model_description(str(fmu_path))
     unzipdir = extract(str(fmu_path), tempfile.mkdtemp())
-    g = ssp.harmonic_ground(W, A_G)
+    g = ssp.system_ground(archives[name], W, A_G if added else 0.0)
     err = {}
     for h in (H, H / 2):
-        host = run("libcosim", archives[name], h=h)
+        host = run("libcosim", archives[name], h=h, added=added)
         py = simulate(cfg, unzipdir, md, g, h, T_END)
         err[h] = (rel(host["Building.roof.x"], py["X"][:, -1]), rel(host["TLD.force"], py["F"][:, 0]))
-    print(f"\n{name} vs tld_fmu.building: max relative difference (roof.x, force) "
+    print(f"\n{name} ({'with' if added else 'without'} ground.a) vs tld_fmu.building: "
+          "max relative difference (roof.x, force) "
           + ", ".join(f"h = {h}: {e[0]:.2e}, {e[1]:.2e}" for h, e in err.items()))
     for j in range(2):
         ratio = err[H][j] / err[H / 2][j]
@@ -194,12 +223,21 @@ def test_building_py_agrees_at_the_coupling_order(archives, fmu_path, name):
 
 def test_libcosim_runs_the_default_experiment(archives):
     """With no step size given, libcosim takes the fixed-step algorithm of the default
-    experiment's annotation (0.01 s)."""
+    experiment's annotation (0.01 s), and with nothing set the building moves (its built-in
+    ground motion)."""
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
     log_output_level(CosimLogLevel.WARNING)
     stop, step = ssp.SYSTEMS["tld_table21"][2]
+    assert ssp.default_experiment(archives["tld_table21"]) == (stop, step)
     ex = CosimExecution.from_ssp_file(str(archives["tld_table21"]))
-    assert ex.step(3)
-    assert ex.status().current_time == 3 * round(step * 1e9)
+    obs = CosimObserver.create_last_value()
+    ex.add_observer(obs)
+    assert ex.step(100)
+    assert ex.status().current_time == 100 * round(step * 1e9)
+    index = {s.name.decode(): s.index for s in ex.slave_infos()}
+    vr = {v.name.decode(): v.reference for v in ex.slave_variables(index["Building"])}
+    roof = obs.last_real_values(index["Building"], [vr["roof.x"]])[0]
+    assert abs(roof) > 1e-4, f"roof.x {roof} after 1 s: the building does not move"
     assert f'stopTime="{stop!r}"' in ssp.read(archives["tld_table21"], "SystemStructure.ssd")

@@ -36,7 +36,7 @@ stiffs = [add(f"storey[{i}].stiffness", 200 + i - 1, ty="Real", unit="N/m", star
           for i in range(1, N + 1)]
 I = dict(causality="input", variability="continuous")
 ground_a = add("ground.a", 20, ty="Real", unit="m/s2", start=0,
-               description="ground acceleration, +x", **I)
+               description="ground acceleration, +x (added to the built-in motion of ground.amplitude, ground.omega)", **I)
 tld_force = add("tld.force", 21, ty="Real", unit="N", start=0,
                 description="force of the damper on its floor, +x (TLD.fmu's force)", **I)
 floor_f = [add(f"floor[{i}].force", 300 + i - 1, ty="Real", unit="N", start=0,
@@ -45,7 +45,7 @@ O = dict(causality="output", variability="continuous", initial="calculated")
 tld_a = add("tld.a", 30, ty="Real", unit="m/s2",
             description="absolute acceleration of the damper's floor (TLD.fmu's base.a); feeds through tld.force and the floor forces", **O)
 tld_v = add("tld.v", 31, ty="Real", unit="m/s",
-            description="absolute velocity of the damper's floor (TLD.fmu's base.v): ground velocity from ground.a from rest plus the floor's relative velocity", **O)
+            description="absolute velocity of the damper's floor (TLD.fmu's base.v): the ground's velocity (integrated from ground.a from rest, plus the built-in motion's) plus the floor's relative velocity", **O)
 tld_x = add("tld.x", 32, ty="Real", unit="m",
             description="absolute displacement of the damper's floor (TLD.fmu's base.x), likewise", **O)
 roof_x = add("roof.x", 33, ty="Real", unit="m", description="displacement of floor N relative to the ground", **O)
@@ -62,6 +62,14 @@ w2 = add("mode[2].omega", 41, ty="Real", unit="rad/s",
          description="circular frequency of mode 2 (one storey: mode 1's)", **C)
 alpha = add("damping.alpha", 42, ty="Real", unit="1/s", description="Rayleigh mass coefficient: C = alpha M + beta K", **C)
 beta = add("damping.beta", 43, ty="Real", unit="s", description="Rayleigh stiffness coefficient", **C)
+# Added after the rest (indices of the variables above unchanged): the built-in ground motion.
+ground_amp = add("ground.amplitude", 6, ty="Real", unit="m", start=0, min=-1000, max=1000,
+                 description="A, amplitude of the built-in harmonic ground displacement x_g = A sin(ground.omega t) "
+                             "(ground velocity A omega at t = 0, acceleration -A omega^2 sin(omega t)), added to "
+                             "ground.a; 0 (default): none", **P)
+ground_w = add("ground.omega", 7, ty="Real", unit="rad/s", start=5.6389, min=0, max=10000,
+               description="omega, circular frequency of the built-in ground motion (default 5.6389: the "
+                           "default one-storey building's own frequency)", **P)
 
 
 def deps(xs):
@@ -73,7 +81,9 @@ everything = structure + stiffs + [zeta, zeta1, zeta2]
 forces = [tld_force] + floor_f
 outputs = []  # (index, output deps, initial deps)
 outputs.append((tld_a, forces, forces + structure))
-for k in [tld_v, tld_x, roof_x, shear] + floor_x:
+# tld.v starts at the built-in ground motion's velocity A omega
+outputs.append((tld_v, [], [ground_amp, ground_w]))
+for k in [tld_x, roof_x, shear] + floor_x:
     outputs.append((k, [], []))
 for i, k in enumerate(floor_a):
     outputs.append((k, [tld_force, floor_f[i]], [tld_force, floor_f[i]] + structure))

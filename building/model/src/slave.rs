@@ -14,7 +14,7 @@ use crate::propagator::{Cache, ORDERS};
 use crate::structure::{self, Design};
 
 /// A running building: its structure, first-order system, cached steps and state
-/// z = [u, u', x_g, v_g], with room for a step's input polynomial and next state (a step
+/// z = [u, u', x_g, v_g, h, v_h] (h: the built-in ground motion's displacement), with room for a step's input polynomial and next state (a step
 /// allocates nothing).
 #[derive(Clone, Debug)]
 struct Simulation {
@@ -30,7 +30,7 @@ struct Simulation {
 impl Simulation {
     fn new(building: structure::Building) -> Self {
         let (a, b) = building.state_space();
-        let (z, next) = (vec![0.0; building.states()], vec![0.0; building.states()]);
+        let (z, next) = (building.initial_state(), vec![0.0; building.states()]);
         let p = vec![0.0; (ORDERS + 1) * building.channels()];
         Simulation {
             building,
@@ -93,6 +93,10 @@ fn design(values: &[f64]) -> Result<Design, String> {
         ],
         damper_floor: floor,
         damper_mass: value(values, vr::TLD_MASS),
+        ground: structure::Harmonic {
+            amplitude: value(values, vr::GROUND_AMPLITUDE),
+            omega: value(values, vr::GROUND_OMEGA),
+        },
     })
 }
 
@@ -189,8 +193,10 @@ impl Building {
         let p = self.channels(s, 0);
         let dp = self.channels(s, 1);
         let a = b.accelerations(z, &p[1..]);
-        // u'' (relative), then the state's derivative [u', u''] for the linear outputs.
-        let relative: Vec<f64> = a.iter().map(|ai| ai - p[0]).collect();
+        // u'' (relative: less the whole ground acceleration), then the state's derivative
+        // [u', u''] for the linear outputs.
+        let ag = b.ground_acceleration(z, p[0]);
+        let relative: Vec<f64> = a.iter().map(|ai| ai - ag).collect();
         let mut dz = z[n..2 * n].to_vec();
         dz.extend_from_slice(&relative);
         // a' = M^-1 (F' - C u'' - K u'): the accelerations of [u', u''] under the force rates.
@@ -239,7 +245,8 @@ impl Slave for Building {
     const TABLE: &'static Table = &TABLE;
     const MARK: u64 = 0x4255_494c_4449_4e47;
     const STATE_TAG: [u8; 4] = *b"BLDs";
-    const STATE_VERSION: u16 = 1;
+    /// 2: the state holds the built-in ground motion's oscillator (h, v_h); 1 did not.
+    const STATE_VERSION: u16 = 2;
 
     fn new() -> Self {
         Building {
@@ -356,7 +363,7 @@ impl Slave for Building {
     }
 
     /// Values of all variables | input derivatives (orders 1, 2 of every variable) | the state
-    /// z = [u, u', x_g, v_g] (empty before initialisation).
+    /// z = [u, u', x_g, v_g, h, v_h] (empty before initialisation).
     fn save(&self, out: &mut Vec<u8>) {
         put_f64_list(out, &self.values);
         let flat: Vec<f64> = self.derivatives.iter().flatten().copied().collect();

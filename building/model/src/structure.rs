@@ -12,6 +12,13 @@
 //! C = alpha M + beta K with zeta_i = alpha / (2 omega_i) + beta omega_i / 2 at modes 1 and 2.
 //! The state adds the ground's velocity and displacement (x_g' = v_g, v_g' = a_g) so that the
 //! damper's floor can report its absolute motion.
+//!
+//! The ground acceleration is the input's plus a built-in harmonic motion, the ground
+//! displacement A sin(w t) (velocity A w cos(w t), acceleration -A w^2 sin(w t)): a second
+//! oscillator in the state, h' = v_h, v_h' = -w^2 h, from h = 0, v_h = A w, so that
+//! a_g = a_in - w^2 h. Being part of the linear system it is advanced by the same exact step as
+//! the building: its response has no time-stepping error. x_g, v_g are the ground's whole
+//! motion (the input's, integrated from rest, plus the harmonic's): v_g starts at A w.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
@@ -31,6 +38,17 @@ pub struct Design {
     pub damper_floor: usize,
     /// The damper's mass moving rigidly with its floor (TLD.fmu's mass.inactive, kg).
     pub damper_mass: f64,
+    /// The built-in ground motion.
+    pub ground: Harmonic,
+}
+
+/// A harmonic ground displacement x_g = amplitude sin(omega t).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Harmonic {
+    /// m (0: none).
+    pub amplitude: f64,
+    /// rad/s.
+    pub omega: f64,
 }
 
 /// A configured building: its matrices, modes and damping.
@@ -50,6 +68,8 @@ pub struct Building {
     pub beta: f64,
     /// 0-based index of the damper's floor.
     pub damper: usize,
+    /// The built-in ground motion.
+    pub ground: Harmonic,
 }
 
 impl Building {
@@ -72,6 +92,12 @@ impl Building {
         }
         if !(d.damper_mass.is_finite() && d.damper_mass >= 0.0) {
             return Err(format!("tld.mass = {} must be >= 0", d.damper_mass));
+        }
+        let Harmonic { amplitude, omega } = d.ground;
+        if !(amplitude.is_finite() && omega.is_finite() && omega >= 0.0) {
+            return Err(format!(
+                "ground.amplitude = {amplitude}, ground.omega = {omega}: finite, omega >= 0"
+            ));
         }
         let mut mass = DVector::from_column_slice(&d.masses);
         mass[d.damper_floor - 1] += d.damper_mass;
@@ -98,12 +124,31 @@ impl Building {
             alpha,
             beta,
             damper: d.damper_floor - 1,
+            ground: d.ground,
         })
     }
 
-    /// Dimension of the first-order state [u, u', x_g, v_g].
+    /// Dimension of the first-order state [u, u', x_g, v_g, h, v_h].
     pub fn states(&self) -> usize {
-        2 * self.n + 2
+        2 * self.n + 4
+    }
+
+    /// The state at t = 0: the building at rest relative to the ground, the ground at its
+    /// place, moving with the built-in motion's velocity A w.
+    pub fn initial_state(&self) -> Vec<f64> {
+        let n = self.n;
+        let mut z = vec![0.0; self.states()];
+        let v0 = self.ground.amplitude * self.ground.omega;
+        z[2 * n + 1] = v0;
+        z[2 * n + 3] = v0;
+        z
+    }
+
+    /// The ground's acceleration in the state `z` with `input` the input's (ground.a): the
+    /// input's plus the built-in motion's, -w^2 h.
+    pub fn ground_acceleration(&self, z: &[f64], input: f64) -> f64 {
+        let w = self.ground.omega;
+        input - w * w * z[2 * self.n + 2]
     }
 
     /// Number of input channels [a_g, F_1..F_n].
@@ -111,7 +156,9 @@ impl Building {
         self.n + 1
     }
 
-    /// The first-order system z' = A z + B p with z = [u, u', x_g, v_g], p = [a_g, F].
+    /// The first-order system z' = A z + B p with z = [u, u', x_g, v_g, h, v_h], p = [a_in, F]:
+    /// the ground acceleration a_g = a_in - w^2 h enters u'' and v_g', the oscillator
+    /// h'' = -w^2 h is free.
     pub fn state_space(&self) -> (DMatrix<f64>, DMatrix<f64>) {
         let n = self.n;
         let (s, m) = (self.states(), self.channels());
@@ -126,8 +173,16 @@ impl Building {
             b[(n + i, 0)] = -1.0;
             b[(n + i, 1 + i)] = 1.0 / self.mass[i];
         }
+        let (h, w2) = (2 * n + 2, self.ground.omega * self.ground.omega);
+        // a_g = a_in - w^2 h: -a_g in every u'', +a_g in v_g'
+        for i in 0..n {
+            a[(n + i, h)] = w2;
+        }
         a[(2 * n, 2 * n + 1)] = 1.0;
         b[(2 * n + 1, 0)] = 1.0;
+        a[(2 * n + 1, h)] = -w2;
+        a[(h, h + 1)] = 1.0;
+        a[(h + 1, h)] = -w2;
         (a, b)
     }
 
@@ -207,6 +262,10 @@ mod tests {
             zeta,
             damper_floor: 2,
             damper_mass: 0.5,
+            ground: Harmonic {
+                amplitude: 0.02,
+                omega: 3.0,
+            },
         })
         .expect("a valid design")
     }
@@ -243,21 +302,47 @@ mod tests {
         }
     }
 
-    /// The first-order system's acceleration rows are the absolute accelerations less a_g.
+    /// The first-order system's acceleration rows are the absolute accelerations less a_g,
+    /// the ground's a_in plus the built-in motion's -w^2 h, and the oscillator is free.
     #[test]
     fn state_space_agrees_with_the_accelerations() {
         let b = two_storeys([0.02, 0.03]);
         let (a, bm) = b.state_space();
-        let z = [0.01, -0.02, 0.3, 0.1, 0.5, -0.2];
-        let (ag, f) = (0.7, [3.0, -1.0]);
-        let p = DVector::from_vec(vec![ag, f[0], f[1]]);
+        let z = [0.01, -0.02, 0.3, 0.1, 0.5, -0.2, 0.004, -0.05];
+        let (a_in, f) = (0.7, [3.0, -1.0]);
+        let p = DVector::from_vec(vec![a_in, f[0], f[1]]);
         let dz = &a * DVector::from_column_slice(&z) + &bm * &p;
         let acc = b.accelerations(&z, &f);
+        let ag = b.ground_acceleration(&z, a_in);
+        assert_eq!(ag, a_in - 9.0 * 0.004);
         for i in 0..2 {
             assert!((dz[2 + i] - (acc[i] - ag)).abs() < 1e-12);
             assert_eq!(dz[i], z[2 + i]);
         }
         assert_eq!((dz[4], dz[5]), (z[5], ag));
+        assert_eq!((dz[6], dz[7]), (z[7], -9.0 * z[6]));
+    }
+
+    /// The built-in ground motion alone, stepped exactly: the ground's state is
+    /// x_g = A sin(w t), v_g = A w cos(w t) at every step (the building's response to it is
+    /// the slave's tests').
+    #[test]
+    fn the_built_in_ground_motion_is_a_sine_from_its_initial_state() {
+        let b = two_storeys([0.02, 0.03]);
+        let (a, bm) = b.state_space();
+        let (amp, w, h) = (b.ground.amplitude, b.ground.omega, 0.037);
+        let prop = crate::propagator::Propagator::new(&a, &bm, h);
+        let mut z = b.initial_state();
+        let mut next = z.clone();
+        let p = vec![0.0; 3 * b.channels()];
+        for k in 1..=400 {
+            prop.advance(&z, &p, &mut next);
+            std::mem::swap(&mut z, &mut next);
+            let t = k as f64 * h;
+            let (x, v) = (amp * (w * t).sin(), amp * w * (w * t).cos());
+            assert!((z[4] - x).abs() < 1e-14 && (z[6] - x).abs() < 1e-14, "{k}");
+            assert!((z[5] - v).abs() < 1e-13 && (z[7] - v).abs() < 1e-13, "{k}");
+        }
     }
 
     #[test]
@@ -269,6 +354,7 @@ mod tests {
             zeta: [0.02, 0.02],
             damper_floor: 2,
             damper_mass: 0.0,
+            ground: Harmonic::default(),
         };
         assert!(
             bad(Design {
@@ -290,6 +376,16 @@ mod tests {
                 ..good.clone()
             })
             .contains("negative coefficient")
+        );
+        assert!(
+            bad(Design {
+                ground: Harmonic {
+                    amplitude: 1e-3,
+                    omega: -1.0
+                },
+                ..good.clone()
+            })
+            .contains("ground.omega = -1")
         );
         assert!(Building::new(&good).is_ok());
     }
