@@ -4,7 +4,7 @@
 //! variable. The checks every setter makes (type, causality, variability, range) live here.
 
 use crate::calls::Phase;
-use crate::status::{Refusal, refuse};
+use crate::status::{Refusal, Reply, Status, refuse};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VarType {
@@ -153,6 +153,37 @@ impl Table {
             return Err(refuse(format!("{function}: {reason}")));
         }
         Ok(index)
+    }
+
+    /// fmi2GetRealOutputDerivatives of a slave whose outputs have exact first derivatives: for
+    /// each of `vrs`, an output (`output` names which, `None`: not an output) asked for order 1,
+    /// its `rate` in the running `model` (`None`: not initialised), handed to `put` with its
+    /// position.
+    pub fn first_output_derivatives<M: Copy, W>(
+        &self,
+        model: Option<M>,
+        vrs: &[u32],
+        orders: &[i32],
+        output: impl Fn(u32) -> Option<W>,
+        rate: impl Fn(M, W) -> f64,
+        mut put: impl FnMut(usize, f64),
+    ) -> Reply {
+        const F: &str = "fmi2GetRealOutputDerivatives";
+        let model = model.ok_or_else(|| refuse(format!("{F}: not initialised")))?;
+        for (k, (&r, &order)) in vrs.iter().zip(orders).enumerate() {
+            let (_, var) = self.variable(r, F)?;
+            let Some(which) = output(r) else {
+                return Err(refuse(format!("{F}: '{}' is not an output", var.name)));
+            };
+            if order != 1 {
+                return Err(refuse(format!(
+                    "{F}: order {order} of '{}' is not offered (maxOutputDerivativeOrder = 1)",
+                    var.name
+                )));
+            }
+            put(k, rate(model, which));
+        }
+        Ok(Status::Ok)
     }
 
     /// Checks of fmi2SetRealInputDerivatives for one entry: a Real input, order 1 or up to
