@@ -216,6 +216,32 @@ impl Table {
     }
 }
 
+/// The body of an FMU's model description module: the code its build script writes with the
+/// workspace's generator (build/generate.rs) into `$OUT_DIR/model_description.rs` (`VARIABLES`,
+/// `vr::*`, `GUID`, ...), that table as the shared layer reads it (`TABLE`), and `index_of`.
+/// The module brings the types the generated code names into scope first
+/// (`pub use fmi2_slave::description::{Causality, Table, VarType, Variability, Variable};`).
+#[macro_export]
+macro_rules! model_description {
+    () => {
+        include!(concat!(env!("OUT_DIR"), "/model_description.rs"));
+
+        /// The table as the shared FMI layer reads it.
+        pub const TABLE: $crate::description::Table = $crate::description::Table {
+            model_identifier: MODEL_IDENTIFIER,
+            guid: GUID,
+            variables: VARIABLES,
+            vr_index: &VR_INDEX,
+            log_categories: &LOG_CATEGORIES,
+        };
+
+        /// Position in [`VARIABLES`] of a value reference, if it names a variable.
+        pub const fn index_of(vr: u32) -> Option<usize> {
+            TABLE.index_of(vr)
+        }
+    };
+}
+
 #[cold]
 pub fn unknown(vr: u32, function: &str) -> Refusal {
     refuse(format!("{function}: unknown value reference {vr}"))
