@@ -6,22 +6,10 @@
 //!   their values as discriminants, `ALL`, `from_value`/`from_f64`/`TryFrom<i64>`, `value()`,
 //!   `name()`, `description()`;
 //! - `LOG_CATEGORIES` and `log_category::*` (one constant per category);
-//! - `limits::*`: the declared bounds (`limits::MODES_MAX` is the max of `modes`).
+//! - `limits::*`: the declared bounds (`limits::MODES_MAX` is the max of `modes`);
+//! - `TABLE`, the table the shared FMI layer reads, and `index_of` (both, with the generated
+//!   code, from `fmi2_slave::model_description!`, which Building's description uses too).
 
 pub use fmi2_slave::description::{Causality, Table, VarType, Variability, Variable, finite};
 
-include!(concat!(env!("OUT_DIR"), "/model_description.rs"));
-
-/// The table as the shared FMI layer reads it.
-pub const TABLE: Table = Table {
-    model_identifier: MODEL_IDENTIFIER,
-    guid: GUID,
-    variables: VARIABLES,
-    vr_index: &VR_INDEX,
-    log_categories: &LOG_CATEGORIES,
-};
-
-/// Position in [`VARIABLES`] of a value reference, if it names a variable.
-pub const fn index_of(vr: u32) -> Option<usize> {
-    TABLE.index_of(vr)
-}
+fmi2_slave::model_description!();

@@ -136,7 +136,7 @@ fn serialised_states_continue_bit_for_bit_elsewhere() {
     drive(&mut a, 50);
     drive(&mut b, 50);
     for r in [vr::TLD_A, vr::TLD_X, vr::ROOF_X, vr::BASE_SHEAR] {
-        assert_eq!(a.get_real(r).to_bits(), b.get_real(r).to_bits());
+        assert_eq!(a.real(r).to_bits(), b.real(r).to_bits());
     }
     let mut bad = bytes.clone();
     bad[bytes.len() / 2] ^= 1;
@@ -167,7 +167,7 @@ fn output_derivatives_are_the_outputs_slopes() {
     let sample = |inst: &mut Instance, k: f64| {
         inst.set_real(vr::GROUND_A, slope * k * dt);
         inst.set_real(vr::TLD_FORCE, force_rate * k * dt);
-        outputs.map(|r| inst.get_real(r))
+        outputs.map(|r| inst.real(r))
     };
     let y0 = sample(&mut inst, 0.0);
     assert_eq!(inst.derivative(vr::GROUND_A, 1, slope), OK);
@@ -215,7 +215,7 @@ fn one_storey_free_vibration_is_the_closed_form() {
             assert_eq!(inst.do_step(h), OK);
             let t = inst.time;
             let want = step(t) - step(t - tp);
-            worst = worst.max((inst.get_real(vr::FLOOR_1__X) - want).abs());
+            worst = worst.max((inst.real(vr::FLOOR_1__X) - want).abs());
         }
     }
     assert!(worst < 1e-13, "largest error {worst:e} m");
@@ -254,7 +254,7 @@ fn one_long_step_equals_two_short_ones_for_polynomial_inputs() {
         } else {
             drive(&mut inst, 0.0, 2.0 * h);
         }
-        outputs.map(|r| inst.get_real(r))
+        outputs.map(|r| inst.real(r))
     };
     let (whole, split) = (run(false), run(true));
     for k in 0..outputs.len() {

@@ -75,11 +75,7 @@ fn version_2_state_is_pinned_and_continues_bit_for_bit() {
     drive(&mut run, BEFORE, AFTER);
     drive(&mut restored, BEFORE, AFTER);
     for r in [vr::TLD_A, vr::TLD_V, vr::TLD_X, vr::ROOF_X, vr::BASE_SHEAR] {
-        assert_eq!(
-            run.get_real(r).to_bits(),
-            restored.get_real(r).to_bits(),
-            "{r}"
-        );
+        assert_eq!(run.real(r).to_bits(), restored.real(r).to_bits(), "{r}");
     }
 }
 

@@ -26,7 +26,7 @@ fn fmi_layer_is_transparent() {
         assert_eq!(inst.set_real(vr::GROUND_A, ground(inst.time)), OK);
         assert_eq!(inst.do_step(h), OK);
     }
-    let through_fmi = inst.get_real(vr::ROOF_X);
+    let through_fmi = inst.real(vr::ROOF_X);
     // The model description's defaults for the two storeys.
     let building = Building::new(&Design {
         masses: vec![168.0; 2],
@@ -64,7 +64,8 @@ fn fmi_layer_is_transparent() {
 /// Instances in threads give the serial runs' numbers bit for bit.
 #[test]
 fn concurrent_instances_match_serial_runs() {
-    let run = |name: String, storeys: usize| {
+    let cases: Vec<usize> = (1..=8).collect();
+    assert_threads_match_serial(&cases, |name, storeys| {
         let mut inst = Instance::new(&name);
         inst.initialise(&[(vr::STOREYS, storeys as f64)]);
         for _ in 0..200 {
@@ -72,44 +73,13 @@ fn concurrent_instances_match_serial_runs() {
             assert_eq!(inst.set_real(vr::GROUND_A, (3.0 * t).sin()), OK);
             assert_eq!(inst.do_step(0.01), OK);
         }
-        inst.get_real(vr::TLD_A).to_bits()
-    };
-    let cases: Vec<usize> = (1..=8).collect();
-    let serial: Vec<u64> = cases
-        .iter()
-        .map(|&n| run(format!("serial-{n}"), n))
-        .collect();
-    let threads: Vec<_> = cases
-        .iter()
-        .map(|&n| std::thread::spawn(move || run(format!("thread-{n}"), n)))
-        .collect();
-    let parallel: Vec<u64> = threads
-        .into_iter()
-        .map(|t| t.join().expect("thread"))
-        .collect();
-    assert_eq!(serial, parallel);
+        inst.real(vr::TLD_A).to_bits()
+    });
 }
 
 /// The library exports the 44 fmi2 functions and nothing of its own but fmi-sys's
-/// `callback_log` (see TLD's tests/library.rs).
+/// `callback_log` (see tests/fmi_host).
 #[test]
 fn exports_only_fmi2_functions() {
-    let out = std::process::Command::new("nm")
-        .args(["-D", "--defined-only"])
-        .arg(library_path())
-        .output()
-        .expect("nm (binutils) must be installed");
-    assert!(out.status.success());
-    let text = String::from_utf8_lossy(&out.stdout);
-    let symbols: Vec<&str> = text
-        .lines()
-        .filter_map(|l| l.split_whitespace().nth(2))
-        .collect();
-    let fmi = symbols.iter().filter(|s| s.starts_with("fmi2")).count();
-    let other: Vec<&&str> = symbols.iter().filter(|s| !s.starts_with("fmi2")).collect();
-    assert_eq!(fmi, 44, "{symbols:?}");
-    assert!(
-        other.iter().all(|s| **s == "callback_log"),
-        "unexpected exports {other:?}"
-    );
+    assert_exports_only_fmi2_functions();
 }

@@ -4,7 +4,7 @@
 //! variable. The checks every setter makes (type, causality, variability, range) live here.
 
 use crate::calls::Phase;
-use crate::status::{Refusal, refuse};
+use crate::status::{Refusal, Reply, Status, refuse};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VarType {
@@ -155,6 +155,37 @@ impl Table {
         Ok(index)
     }
 
+    /// fmi2GetRealOutputDerivatives of a slave whose outputs have exact first derivatives: for
+    /// each of `vrs`, an output (`output` names which, `None`: not an output) asked for order 1,
+    /// its `rate` in the running `model` (`None`: not initialised), handed to `put` with its
+    /// position.
+    pub fn first_output_derivatives<M: Copy, W>(
+        &self,
+        model: Option<M>,
+        vrs: &[u32],
+        orders: &[i32],
+        output: impl Fn(u32) -> Option<W>,
+        rate: impl Fn(M, W) -> f64,
+        mut put: impl FnMut(usize, f64),
+    ) -> Reply {
+        const F: &str = "fmi2GetRealOutputDerivatives";
+        let model = model.ok_or_else(|| refuse(format!("{F}: not initialised")))?;
+        for (k, (&r, &order)) in vrs.iter().zip(orders).enumerate() {
+            let (_, var) = self.variable(r, F)?;
+            let Some(which) = output(r) else {
+                return Err(refuse(format!("{F}: '{}' is not an output", var.name)));
+            };
+            if order != 1 {
+                return Err(refuse(format!(
+                    "{F}: order {order} of '{}' is not offered (maxOutputDerivativeOrder = 1)",
+                    var.name
+                )));
+            }
+            put(k, rate(model, which));
+        }
+        Ok(Status::Ok)
+    }
+
     /// Checks of fmi2SetRealInputDerivatives for one entry: a Real input, order 1 or up to
     /// `max_order`, a finite value.
     pub fn check_input_derivative(
@@ -183,6 +214,32 @@ impl Table {
         }
         Ok(var)
     }
+}
+
+/// The body of an FMU's model description module: the code its build script writes with the
+/// workspace's generator (build/generate.rs) into `$OUT_DIR/model_description.rs` (`VARIABLES`,
+/// `vr::*`, `GUID`, ...), that table as the shared layer reads it (`TABLE`), and `index_of`.
+/// The module brings the types the generated code names into scope first
+/// (`pub use fmi2_slave::description::{Causality, Table, VarType, Variability, Variable};`).
+#[macro_export]
+macro_rules! model_description {
+    () => {
+        include!(concat!(env!("OUT_DIR"), "/model_description.rs"));
+
+        /// The table as the shared FMI layer reads it.
+        pub const TABLE: $crate::description::Table = $crate::description::Table {
+            model_identifier: MODEL_IDENTIFIER,
+            guid: GUID,
+            variables: VARIABLES,
+            vr_index: &VR_INDEX,
+            log_categories: &LOG_CATEGORIES,
+        };
+
+        /// Position in [`VARIABLES`] of a value reference, if it names a variable.
+        pub const fn index_of(vr: u32) -> Option<usize> {
+            TABLE.index_of(vr)
+        }
+    };
 }
 
 #[cold]

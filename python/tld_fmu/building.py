@@ -172,10 +172,7 @@ class Damper:
         runs of a study)."""
         if not fresh:
             self.fmu.reset()
-        self.fmu.setupExperiment(startTime=0.0)
-        self.contract.set(self.fmu, {"tanks": tanks, **params})
-        self.fmu.enterInitializationMode()
-        self.fmu.exitInitializationMode()
+        self.contract.initialise(self.fmu, {"tanks": tanks, **params})
         self.floor = floor - 1
         self.inactive = self.fmu.getReal([self.var["mass.inactive"].valueReference])[0]
         self.read()

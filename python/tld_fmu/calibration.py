@@ -42,25 +42,25 @@ def plot(csv_path: Path, png: Path, title: str, sweeps_path: Path | None = None,
     sweeps = read_sweeps(sweeps_path) if sweeps_path else []
     panels = 3 if sweeps else 2
     fig, axes = plt.subplots(1, panels, figsize=(5.5 * panels, 4.5))
-    a1, a2 = axes[0], axes[1]
     lam = d["lambda"]
     data_label = "shallow-water sweeps" if sweeps else "data"
-    a1.semilogx(lam, d["kappa_data"], "o", label=data_label)
-    a1.semilogx(lam, d["kappa_model"], "-",
-                label=f"Nonlinear model fitted: phi = {fit['phi']:.3g}, eta = {fit['eta']:.3g}")
-    a1.semilogx(lam, d["kappa_nsd"], "k--", lw=1, label="NSD law (fit of experiments)")
-    a1.set_xlabel("Lambda = A_e / a")
-    a1.set_ylabel("kappa = quadrature frequency / w_f")
-    a1.legend(fontsize=8)
-    a1.grid(alpha=0.3)
-    a2.loglog(lam, d["zeta_data"], "o", label=data_label)
-    a2.loglog(lam, d["zeta_model"], "-",
-              label=f"zeta = {fit['nsd_c']:.3g} Lambda^{fit['nsd_p']:.3g} fitted")
-    a2.loglog(lam, d["zeta_nsd"], "k--", lw=1, label="NSD law: 0.5 Lambda^0.35")
-    a2.set_xlabel("Lambda = A_e / a")
-    a2.set_ylabel("zeta (energy-equivalent at quadrature)")
-    a2.legend(fontsize=8)
-    a2.grid(alpha=0.3, which="both")
+
+    def fit_panel(ax, draw, quantity, model_label, nsd_label, ylabel, **grid):
+        """`quantity` over Lambda, drawn by the axes' method `draw`: data, fitted model, NSD law."""
+        draw = getattr(ax, draw)
+        draw(lam, d[f"{quantity}_data"], "o", label=data_label)
+        draw(lam, d[f"{quantity}_model"], "-", label=model_label)
+        draw(lam, d[f"{quantity}_nsd"], "k--", lw=1, label=nsd_label)
+        ax.set_xlabel("Lambda = A_e / a")
+        ax.set_ylabel(ylabel)
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3, **grid)
+
+    fit_panel(axes[0], "semilogx", "kappa",
+              f"Nonlinear model fitted: phi = {fit['phi']:.3g}, eta = {fit['eta']:.3g}",
+              "NSD law (fit of experiments)", "kappa = quadrature frequency / w_f")
+    fit_panel(axes[1], "loglog", "zeta", f"zeta = {fit['nsd_c']:.3g} Lambda^{fit['nsd_p']:.3g} fitted",
+              "NSD law: 0.5 Lambda^0.35", "zeta (energy-equivalent at quadrature)", which="both")
     if sweeps:
         a3 = axes[2]
         half = (length or 1.0) / 2

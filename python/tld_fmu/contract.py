@@ -82,6 +82,14 @@ class Contract:
         for vr, setter, value in self.typed(values):
             setters[setter]([vr], [value])
 
+    def initialise(self, fmu, values: dict, start: float = 0.0, tolerance=None):
+        """Initialise an instantiated fmpy FMU2Slave: fmi2SetupExperiment at `start`, then
+        {name: value} set (see `set`), fmi2EnterInitializationMode, fmi2ExitInitializationMode."""
+        fmu.setupExperiment(tolerance=tolerance, startTime=start)
+        self.set(fmu, values)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+
 
 @functools.cache
 def default() -> Contract:

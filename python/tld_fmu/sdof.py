@@ -83,10 +83,7 @@ def cosimulate(unzipdir, w, A_g, h, t_end, params=None, t_window=20.0, record=Fa
                     modelIdentifier=md.coSimulation.modelIdentifier, instanceName=f"tld_{w:.4f}")
     fmu.instantiate()
     try:
-        fmu.setupExperiment(startTime=0.0)
-        contract.set(fmu, params)
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
+        contract.initialise(fmu, params)
         m0 = fmu.getReal([vr["mass.inactive"]])[0]
         mass = M_S + m0
 

@@ -89,11 +89,7 @@ class Slave:
 
     # -- life cycle -------------------------------------------------------------------------------
     def initialize(self, params: dict | None = None, tolerance=None, start=0.0):
-        self.fmu.setupExperiment(tolerance=tolerance, startTime=start)
-        if params:
-            self.set_vars(params)
-        self.fmu.enterInitializationMode()
-        self.fmu.exitInitializationMode()
+        self.contract.initialise(self.fmu, params or {}, start=start, tolerance=tolerance)
         self.time = start
         return self
 

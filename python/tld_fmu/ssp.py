@@ -154,10 +154,7 @@ def inactive_mass(tld_fmu: Path, params: dict) -> float:
                         modelIdentifier=md.coSimulation.modelIdentifier, instanceName="mass")
         fmu.instantiate()
         try:
-            fmu.setupExperiment(startTime=0.0)
-            contract.set(fmu, params)
-            fmu.enterInitializationMode()
-            fmu.exitInitializationMode()
+            contract.initialise(fmu, params)
             return fmu.getReal([contract.vr("mass.inactive")])[0]
         finally:
             fmu.terminate()

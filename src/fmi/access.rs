@@ -1,22 +1,22 @@
-//! Variable access of TLD.fmu: the one path of its typed getters and setters, and the input and
-//! output derivatives. Integer and Boolean values travel as f64 inside. The checks every FMU
-//! makes of a set (type, causality, variability, range) are the shared layer's
-//! (`Table::settable`); what is TLD's own is where a value comes from (`params::source_of`).
+//! Variable access of TLD.fmu: where a value comes from (`params::source_of`) for its typed
+//! getters, the checks of its setters, and the input derivatives (the loops over the value
+//! references are its `Slave` methods, fmi/slave.rs). Integer and Boolean values travel as f64
+//! inside. The checks every FMU makes of a set (type, causality, variability, range) are the
+//! shared layer's (`Table::settable`), after TLD's quick path for its per-step inputs.
 
-use fmi2_slave::calls::Phase;
-use fmi2_slave::{Context, Refusal, Reply, Status, refuse};
+use fmi2_slave::{Context, Refusal, Reply, Status};
 
-use super::params::{Source, derived_value, free_real_input, output_of, source_of};
+use super::params::{Source, derived_value, free_real_input, source_of};
 use super::slave::{TABLE, Tld};
-use super::vars::{VARIABLES, VarType, finite, index_of, vr};
+use super::vars::{VARIABLES, VarType, finite, vr};
 use crate::model::{Damper, Output};
 
 /// Who asks for a value that is no load: the instance's context and the calling function, one
 /// pointer (the out-of-line path then takes all its arguments in registers).
 #[derive(Clone, Copy)]
-struct Ask<'a> {
-    context: &'a Context,
-    function: &'a str,
+pub(super) struct Ask<'a> {
+    pub context: &'a Context,
+    pub function: &'a str,
 }
 
 impl Tld {
@@ -24,7 +24,7 @@ impl Tld {
     /// reads after every step of a running simulation. None for anything else, which
     /// [`Tld::value_in_full`] answers out of line.
     #[inline(always)]
-    fn loaded(&self, sim: Option<&Damper>, r: u32, ty: VarType) -> Option<f64> {
+    pub(super) fn loaded(&self, sim: Option<&Damper>, r: u32, ty: VarType) -> Option<f64> {
         match source_of(r, ty) {
             Source::Stored(index) => Some(self.values.at(index)),
             Source::Output(which) => sim?.per_step_output(which),
@@ -32,33 +32,9 @@ impl Tld {
         }
     }
 
-    /// Values of the variables `vrs` of type `ty` into `out`, converted by `to`. The instance's
-    /// phase has been checked.
-    #[inline(always)]
-    pub(super) fn get_values<T>(
-        &self,
-        context: &Context,
-        vrs: &[u32],
-        out: &mut [T],
-        ty: VarType,
-        function: &str,
-        to: fn(f64) -> T,
-    ) -> Reply {
-        // Whether the simulation exists is asked once, not per value.
-        let sim = self.sim.as_ref();
-        for (slot, &r) in out.iter_mut().zip(vrs) {
-            let value = match self.loaded(sim, r, ty) {
-                Some(v) => v,
-                None => self.value_in_full(r, ty, &Ask { context, function })?,
-            };
-            *slot = to(value);
-        }
-        Ok(Status::Ok)
-    }
-
     /// The value of `r` read as `ty` where it is no load, or why there is none.
     #[inline(never)]
-    fn value_in_full(&self, r: u32, ty: VarType, ask: &Ask) -> Result<f64, Refusal> {
+    pub(super) fn value_in_full(&self, r: u32, ty: VarType, ask: &Ask) -> Result<f64, Refusal> {
         let Ask { context, function } = *ask;
         match source_of(r, ty) {
             Source::Stored(index) => Ok(self.values.at(index)),
@@ -97,36 +73,6 @@ impl Tld {
         derived_value(r, &derived).ok_or_else(|| TABLE.no_value(r, function))
     }
 
-    /// Set the variables `vrs` of type `ty` to `values`, converted by `from`: all are checked
-    /// before any is changed. The instance's phase has been checked.
-    #[inline(always)]
-    pub(super) fn set_values<T: Copy>(
-        &mut self,
-        context: &Context,
-        vrs: &[u32],
-        values: &[T],
-        ty: VarType,
-        function: &str,
-        from: fn(T) -> f64,
-    ) -> Reply {
-        // One variable (an input per step, the usual call): checked and set in one pass.
-        if let ([r], [v]) = (vrs, values) {
-            let v = from(*v);
-            let index = Self::check_set(context, *r, v, ty, function)?;
-            self.put(*r, index, v);
-            return Ok(Status::Ok);
-        }
-        for (&r, &v) in vrs.iter().zip(values) {
-            Self::check_set(context, r, from(v), ty, function)?;
-        }
-        for (&r, &v) in vrs.iter().zip(values) {
-            if let Some(index) = index_of(r) {
-                self.put(r, index, from(v));
-            }
-        }
-        Ok(Status::Ok)
-    }
-
     /// The position of `r` if it is a Real input without bounds (the per-step input) and
     /// `value` finite: what the full check would accept, by one table look-up.
     #[inline(always)]
@@ -138,7 +84,7 @@ impl Tld {
     }
 
     #[inline(always)]
-    fn put(&mut self, r: u32, index: usize, value: f64) {
+    pub(super) fn put(&mut self, r: u32, index: usize, value: f64) {
         self.values.set_at(index, value);
         if r == vr::SOLVER_TOLERANCE {
             self.user_tolerance = true;
@@ -157,19 +103,8 @@ impl Tld {
     ) -> Result<usize, Refusal> {
         match Self::free_input(r, value, ty) {
             Some(index) => Ok(index),
-            None => Self::check_in_full(context.phase, r, value, ty, function),
+            None => TABLE.settable(context.phase, r, value, ty, function),
         }
-    }
-
-    #[inline(never)]
-    fn check_in_full(
-        phase: Phase,
-        r: u32,
-        value: f64,
-        ty: VarType,
-        function: &str,
-    ) -> Result<usize, Refusal> {
-        TABLE.settable(phase, r, value, ty, function)
     }
 
     /// fmi2SetRealInputDerivatives: derivatives of Real inputs for the next step. base.a's are
@@ -190,43 +125,13 @@ impl Tld {
         }
         Ok(Status::Ok)
     }
-
-    /// fmi2GetRealOutputDerivatives: exact first derivatives of outputs, handed to `put`.
-    pub(super) fn rates(
-        &self,
-        _: &Context,
-        vrs: &[u32],
-        orders: &[i32],
-        mut put: impl FnMut(usize, f64),
-    ) -> Reply {
-        const F: &str = "fmi2GetRealOutputDerivatives";
-        let sim = self
-            .sim
-            .as_ref()
-            .ok_or_else(|| refuse(format!("{F}: not initialised")))?;
-        let inputs = self.values.inputs(self.a_derivatives);
-        for (k, (&r, &order)) in vrs.iter().zip(orders).enumerate() {
-            let (_, var) = TABLE.variable(r, F)?;
-            let Some(which) = output_of(r) else {
-                return Err(refuse(format!("{F}: '{}' is not an output", var.name)));
-            };
-            if order != 1 {
-                return Err(refuse(format!(
-                    "{F}: order {order} of '{}' is not offered (maxOutputDerivativeOrder = 1)",
-                    var.name
-                )));
-            }
-            put(k, sim.output_derivative(which, &inputs));
-        }
-        Ok(Status::Ok)
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fmi::vars::Causality;
-    use fmi2_slave::calls::allow;
+    use crate::fmi::vars::{Causality, index_of};
+    use fmi2_slave::calls::{Phase, allow};
     use fmi2_slave::frame::Experiment;
 
     /// The quick case of `check_set` must agree with the full check: every variable in its table

@@ -6,7 +6,8 @@
 use fmi2_slave::description::Table;
 use fmi2_slave::{Context, Refusal, Slave, refuse};
 
-use super::params::{Configuration, Values};
+use super::access::Ask;
+use super::params::{Configuration, Values, output_of};
 use super::vars::{self, VARIABLES, finite, index_of, vr};
 use crate::model::{Damper, StepError};
 use crate::solver::SolveError;
@@ -113,9 +114,19 @@ impl Slave for Tld {
         function: &str,
         to: fn(f64) -> T,
     ) -> fmi2_slave::Reply {
-        self.get_values(context, vrs, out, ty, function, to)
+        // Whether the simulation exists is asked once, not per value.
+        let sim = self.sim.as_ref();
+        for (slot, &r) in out.iter_mut().zip(vrs) {
+            let value = match self.loaded(sim, r, ty) {
+                Some(v) => v,
+                None => self.value_in_full(r, ty, &Ask { context, function })?,
+            };
+            *slot = to(value);
+        }
+        Ok(fmi2_slave::Status::Ok)
     }
 
+    /// All are checked before any is changed.
     #[inline(always)]
     fn set<T: Copy>(
         &mut self,
@@ -126,7 +137,22 @@ impl Slave for Tld {
         function: &str,
         from: fn(T) -> f64,
     ) -> fmi2_slave::Reply {
-        self.set_values(context, vrs, values, ty, function, from)
+        // One variable (an input per step, the usual call): checked and set in one pass.
+        if let ([r], [v]) = (vrs, values) {
+            let v = from(*v);
+            let index = Self::check_set(context, *r, v, ty, function)?;
+            self.put(*r, index, v);
+            return Ok(fmi2_slave::Status::Ok);
+        }
+        for (&r, &v) in vrs.iter().zip(values) {
+            Self::check_set(context, r, from(v), ty, function)?;
+        }
+        for (&r, &v) in vrs.iter().zip(values) {
+            if let Some(index) = index_of(r) {
+                self.put(r, index, from(v));
+            }
+        }
+        Ok(fmi2_slave::Status::Ok)
     }
 
     fn set_input_derivatives(
@@ -140,12 +166,15 @@ impl Slave for Tld {
 
     fn output_derivatives(
         &self,
-        context: &Context,
+        _: &Context,
         vrs: &[u32],
         orders: &[i32],
         put: impl FnMut(usize, f64),
     ) -> fmi2_slave::Reply {
-        self.rates(context, vrs, orders, put)
+        // Exact first derivatives of the outputs.
+        let inputs = self.values.inputs(self.a_derivatives);
+        let rate = |sim: &Damper, which| sim.output_derivative(which, &inputs);
+        TABLE.first_output_derivatives(self.sim.as_ref(), vrs, orders, output_of, rate, put)
     }
 
     /// The damper's notice of implausible motion, to the host as a warning once per run.

@@ -11,25 +11,18 @@
 //!   byte-for-byte the one before the call.
 //!
 //! The number of sequences is bounded for CI (PROPTEST_CASES overrides it) and printed.
+//!
+//! The instances are the workspace's raw test host's (tests/fmi_host), which every fuzz test
+//! loads its FMU with and names at its root (`Instance`, `OK`, ...).
 
+use super::{DISCARD, ERROR, Instance, OK};
 use fmi_sys::fmi2::*;
 use proptest::prelude::*;
 use std::ffi::CString;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-const OK: fmi2Status = fmi2Status_fmi2OK;
-const DISCARD: fmi2Status = fmi2Status_fmi2Discard;
-const ERROR: fmi2Status = fmi2Status_fmi2Error;
-
-/// An instance of the FMU under test, freed when dropped.
-pub trait Host {
-    fn lib(&self) -> &'static Fmi2Binding;
-    fn component(&self) -> fmi2Component;
-}
-
-/// What the fuzzer needs of an FMU: a fresh instance, its value references, an output to read.
-pub struct Target<H> {
-    pub new: fn() -> H,
+/// What the fuzzer needs of an FMU besides its library: its value references, an output to read.
+pub struct Target {
     pub value_references: Vec<u32>,
     pub output: u32,
 }
@@ -173,34 +166,20 @@ fn call(known: Vec<u32>) -> impl Strategy<Value = Call> {
 
 /// The instance's complete serialised state (the observer: fmi2GetFMUstate is allowed in every
 /// state and is itself checked by the round-trip tests).
-fn fingerprint<H: Host>(inst: &H) -> Vec<u8> {
-    let (lib, c) = (inst.lib(), inst.component());
-    unsafe {
-        let mut s: fmi2FMUstate = std::ptr::null_mut();
-        assert_eq!(lib.fmi2GetFMUstate(c, &mut s), OK);
-        let mut n = 0usize;
-        assert_eq!(lib.fmi2SerializedFMUstateSize(c, s, &mut n), OK);
-        let mut bytes = vec![0u8; n];
-        assert_eq!(
-            lib.fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr() as *mut fmi2Byte, n),
-            OK
-        );
-        assert_eq!(lib.fmi2FreeFMUstate(c, &mut s), OK);
-        bytes
-    }
+fn fingerprint(inst: &Instance) -> Vec<u8> {
+    inst.serialised()
 }
 
-struct Fuzz<H: Host> {
-    inst: H,
+struct Fuzz {
+    inst: Instance,
     output: u32,
     saved: Option<Vec<u8>>,
     state: fmi2FMUstate,
 }
 
-impl<H: Host> Fuzz<H> {
+impl Fuzz {
     fn perform(&mut self, call: &Call) -> fmi2Status {
-        let lib = self.inst.lib();
-        let c = self.inst.component();
+        let (lib, c) = (self.inst.lib, self.inst.c);
         let t = {
             let mut t = 0.0;
             // The FMU's own time when it has one; 0 otherwise.
@@ -337,16 +316,16 @@ impl<H: Host> Fuzz<H> {
     }
 }
 
-impl<H: Host> Drop for Fuzz<H> {
+impl Drop for Fuzz {
     fn drop(&mut self) {
-        let (lib, c) = (self.inst.lib(), self.inst.component());
+        let (lib, c) = (self.inst.lib, self.inst.c);
         unsafe { lib.fmi2FreeFMUstate(c, &mut self.state) };
     }
 }
 
 /// Runs the fuzzer on `target`; each sequence starts with one drawn from `prefix` (the
 /// parameters that make instances differ, and how far into initialisation it starts).
-pub fn run<H: Host>(target: Target<H>, prefix: impl Strategy<Value = Vec<Call>>) {
+pub fn run(target: Target, prefix: impl Strategy<Value = Vec<Call>>) {
     let cases = std::env::var("PROPTEST_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
@@ -365,7 +344,7 @@ pub fn run<H: Host>(target: Target<H>, prefix: impl Strategy<Value = Vec<Call>>)
         });
     let result = runner.run(&sequences, |calls| {
         let mut fuzz = Fuzz {
-            inst: (target.new)(),
+            inst: Instance::new("fuzz"),
             output: target.output,
             saved: None,
             state: std::ptr::null_mut(),
@@ -398,6 +377,17 @@ pub fn run<H: Host>(target: Target<H>, prefix: impl Strategy<Value = Vec<Call>>)
     if let Err(e) = result {
         panic!("{e}");
     }
+}
+
+/// The prefixes of the sequences: the call `parameters` draws (setting what makes instances
+/// differ), then a third of them initialised, a third in initialisation mode, so that the calls
+/// reach every state, not mostly the first.
+pub fn starting_with(parameters: impl Strategy<Value = Call>) -> impl Strategy<Value = Vec<Call>> {
+    (0..3usize, parameters).prop_map(|(depth, parameters)| {
+        let mut calls = vec![parameters];
+        calls.extend(initialisation(depth));
+        calls
+    })
 }
 
 /// The calls that take a new instance `depth` steps into initialisation: 0 none, 1 into

@@ -19,29 +19,24 @@ struct Fmu {
     variables: &'static [Variable],
 }
 
+/// A file of the workspace (the path from its root), built into the tool.
+macro_rules! workspace_file {
+    ($path:literal) => {
+        include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/../", $path))
+    };
+}
+
 const TLD: Fmu = Fmu {
     id: "TLD",
-    xml: include_str!(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../modelDescription/modelDescription.xml"
-    )),
-    doc: include_str!(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../modelDescription/documentation.html"
-    )),
+    xml: workspace_file!("modelDescription/modelDescription.xml"),
+    doc: workspace_file!("modelDescription/documentation.html"),
     variables: tld_fmu::fmi::vars::VARIABLES,
 };
 
 const BUILDING: Fmu = Fmu {
     id: "Building",
-    xml: include_str!(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../building/model/modelDescription/modelDescription.xml"
-    )),
-    doc: include_str!(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../building/model/modelDescription/documentation.html"
-    )),
+    xml: workspace_file!("building/model/modelDescription/modelDescription.xml"),
+    doc: workspace_file!("building/model/modelDescription/documentation.html"),
     variables: building_model::description::VARIABLES,
 };
 
