@@ -87,9 +87,9 @@ fn version_1_state_is_refused_by_its_version() {
     let old = std::fs::read(&path).expect("building/tests/golden/state-v1.bin");
     let mut inst = configured("golden-v1");
     drive(&mut inst, 0, 3);
-    let before = inst.get_real(vr::ROOF_X);
+    let before = inst.real(vr::ROOF_X);
     assert_ne!(inst.restore(&old), OK);
     let logs = inst.logs().join("\n");
     assert!(logs.contains("version 1 is not supported"), "{logs}");
-    assert_eq!(inst.get_real(vr::ROOF_X).to_bits(), before.to_bits());
+    assert_eq!(inst.real(vr::ROOF_X).to_bits(), before.to_bits());
 }

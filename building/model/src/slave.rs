@@ -339,27 +339,16 @@ impl Slave for Building {
         _: &Context,
         vrs: &[u32],
         orders: &[i32],
-        mut put: impl FnMut(usize, f64),
+        put: impl FnMut(usize, f64),
     ) -> Reply {
-        const F: &str = "fmi2GetRealOutputDerivatives";
-        let s = self
-            .sim
-            .as_ref()
-            .ok_or_else(|| refuse(format!("{F}: not initialised")))?;
-        for (k, (&r, &order)) in vrs.iter().zip(orders).enumerate() {
-            let (_, var) = TABLE.variable(r, F)?;
-            let Some(which) = output_of(r) else {
-                return Err(refuse(format!("{F}: '{}' is not an output", var.name)));
-            };
-            if order != 1 {
-                return Err(refuse(format!(
-                    "{F}: order {order} of '{}' is not offered (maxOutputDerivativeOrder = 1)",
-                    var.name
-                )));
-            }
-            put(k, self.rate(s, which));
-        }
-        Ok(Status::Ok)
+        TABLE.first_output_derivatives(
+            self.sim.as_ref(),
+            vrs,
+            orders,
+            output_of,
+            |s, which| self.rate(s, which),
+            put,
+        )
     }
 
     /// Values of all variables | input derivatives (orders 1, 2 of every variable) | the state
