@@ -7,17 +7,9 @@
 use fmi2_slave::{Context, Refusal, Reply, Status};
 
 use super::params::{Source, derived_value, free_real_input, source_of};
-use super::slave::{TABLE, Tld};
+use super::slave::{Ask, TABLE, Tld};
 use super::vars::{VARIABLES, VarType, finite, vr};
 use crate::model::{Damper, Output};
-
-/// Who asks for a value that is no load: the instance's context and the calling function, one
-/// pointer (the out-of-line path then takes all its arguments in registers).
-#[derive(Clone, Copy)]
-pub(super) struct Ask<'a> {
-    pub context: &'a Context,
-    pub function: &'a str,
-}
 
 impl Tld {
     /// The value of `r` read as `ty` if it is a load: a stored value, or an output a master

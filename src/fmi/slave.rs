@@ -6,11 +6,19 @@
 use fmi2_slave::description::Table;
 use fmi2_slave::{Context, Refusal, Slave, refuse};
 
-use super::access::Ask;
 use super::params::{Configuration, Values, output_of};
 use super::vars::{self, VARIABLES, finite, index_of, vr};
 use crate::model::{Damper, StepError};
 use crate::solver::SolveError;
+
+/// Who asks for a value that is no load: the instance's context and the calling function, one
+/// pointer (the out-of-line path then takes all its arguments in registers). Here, beside the
+/// loops that make it, so that access.rs (which answers it) depends on this file and not back.
+#[derive(Clone, Copy)]
+pub(super) struct Ask<'a> {
+    pub context: &'a Context,
+    pub function: &'a str,
+}
 
 /// The model description as the shared layer reads it.
 pub static TABLE: Table = vars::TABLE;
