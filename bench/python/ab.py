@@ -39,6 +39,8 @@ def build(rev: str | None) -> Path:
     # outside the repository: inside it, cargo would take the checkout for a workspace member
     src = Path(tempfile.gettempdir()) / f"tld-ab-src-{rev}"
     if not src.exists():
+        # a checkout the temp directory lost is still registered: forget it first
+        subprocess.run(["git", "worktree", "prune"], cwd=REPO, check=True)
         subprocess.run(["git", "worktree", "add", "--detach", str(src), rev], cwd=REPO, check=True,
                        capture_output=True)
     env = dict(os.environ, CARGO_TARGET_DIR=str(REPO / "target" / "ab" / f"target-{rev}"))
