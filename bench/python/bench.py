@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tld_fmu.machine import git_info
 from tld_fmu.paths import FMU, REPO
 from tld_fmu.scenes import FmuInfo, compute_references, make_scenes, n_steps, rel_err, _stats
 
@@ -157,15 +158,13 @@ def main():
 def only_study(args, fmu: Path, out: Path):
     """--only study: the design-study section measured anew and put in place of the report's;
     --only study-report: the section written again from the last measurement."""
-    import subprocess
     saved = out / "bench" / "study.json"
     if args.only == "study-report":
         res = json.loads(saved.read_text())
     else:
         t0 = time.perf_counter()
         res = sweep_throughput(fmu, args.quick)
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO, capture_output=True,
-                                text=True).stdout.strip()
+        commit = git_info()
         res["measured"] = (f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} by "
                            f"`scripts/bench --only study` on {commit} in {time.perf_counter() - t0:.0f} s.")
     section = sweep_section(res)

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import datetime
 import os
-import platform
-import subprocess
 from pathlib import Path
 
 import numpy as np
 
+from tld_fmu.machine import git_info, machine_line
 from tld_fmu.paths import REPO
 from tld_fmu.scenes import FmuInfo, n_steps
 
@@ -18,44 +17,8 @@ from .findings import observations, targets
 from .formats import dt_label, fmt_e, fmt_ns
 
 
-def machine_info():
-    model = cores = "?"
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-        for line in out.splitlines():
-            k, _, v = line.partition(":")
-            if k.strip() == "Model name":
-                model = v.strip()
-            if k.strip() == "CPU(s)":
-                cores = v.strip()
-    except OSError:
-        pass
-    mem = "?"
-    try:
-        for line in open("/proc/meminfo"):
-            if line.startswith("MemTotal"):
-                mem = f"{int(line.split()[1]) / 1024 / 1024:.1f} GiB"
-    except OSError:
-        pass
-    return dict(cpu=model, cores=cores, mem=mem, python=platform.python_version(),
-                kernel=platform.release(), openblas=os.environ.get("OPENBLAS_CORETYPE", "unset"))
-
-
-def git_info():
-    try:
-        head = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
-                              capture_output=True, text=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(REPO), "status", "--porcelain", "--", "src",
-                                "Cargo.toml", "modelDescription", "build", "tools"],
-                               capture_output=True, text=True).stdout.strip()
-        return head + (" + uncommitted changes in src/Cargo.toml/modelDescription" if dirty else "")
-    except OSError:
-        return "?"
-
-
 def write_report(args, scenes, refs, rows, stderr_lines, timings, out_md: Path, img_dir: Path,
                  pyfmu_note, fi: FmuInfo, xcheck, extra_sections=()):
-    mi = machine_info()
     L = []
     quick = args.quick
     L.append("# TLD.fmu work-precision benchmark" + (" (QUICK smoke run)" if quick else ""))
@@ -70,8 +33,7 @@ def write_report(args, scenes, refs, rows, stderr_lines, timings, out_md: Path, 
     L.append("|---|---|")
     L.append(f"| date | {datetime.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')} |")
     L.append(f"| command | `{os.environ.get('BENCH_COMMAND', 'scripts/bench')}` |")
-    L.append(f"| machine | {mi['cpu']}, {mi['cores']} cores, {mi['mem']} RAM, Linux "
-             f"{mi['kernel']}, Python {mi['python']}, OPENBLAS_CORETYPE={mi['openblas']} |")
+    L.append(f"| machine | {machine_line()} |")
     L.append(f"| FMU | `{fi.path.relative_to(REPO) if fi.path.is_relative_to(REPO) else fi.path}` "
              f"sha256 {fi.sha256[:16]}…; repository at the time of the run: {git_info()} |")
     L.append(f"| solver items found | " + ", ".join(f"{n} = {v}" for n, v, _ in fi.items("solver"))
