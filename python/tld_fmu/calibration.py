@@ -2,7 +2,8 @@
 
 tld-calibrate writes the samples with the fit (`--csv`: a `# phi=...` comment line, then
 lambda,kappa_data,kappa_model,zeta_data,zeta_model,kappa_nsd,zeta_nsd) and, for the shallow-water
-source, every swept point (`--sweeps`: lambda,direction,ratio,x,phase,x_peak,zeta_eq,cycles,settled).
+source, every swept point (`--sweeps`: lambda,direction,ratio,x,phase,x_peak,zeta_eq,cycles,settled,jump; jump = 1 on
+the last point before a sweep's jump, as tld-calibrate finds it).
 """
 from __future__ import annotations
 
@@ -26,7 +27,8 @@ def read_sweeps(path: Path) -> list[dict]:
     """The swept points of a --sweeps file."""
     with open(path) as fh:
         return [{**r, **{k: float(r[k]) for k in ("lambda", "ratio", "x", "phase", "x_peak", "zeta_eq")},
-                 "cycles": int(r["cycles"]), "settled": r["settled"] == "1"}
+                 "cycles": int(r["cycles"]), "settled": r["settled"] == "1",
+                 "jump": r["jump"] == "1"}
                 for r in csv.DictReader(fh)]
 
 
@@ -93,14 +95,13 @@ def table(csv_path: Path, sweeps_path: Path) -> str:
              "|---|---|---|---|---|---|---|---|---|"]
     for i, lv in enumerate(d["lambda"]):
         def jump(direction: str) -> str:
-            pts = sorted((p for p in sweeps if p["lambda"] == lv and p["direction"] == direction),
-                         key=lambda p: p["ratio"], reverse=direction == "down")
-            best = None
-            for p, q in zip(pts, pts[1:]):
-                change = p["x"] / q["x"] if direction == "up" else q["x"] / p["x"]
-                if change > 1.5 and (best is None or change > best[0]):
-                    best = (change, p["ratio"], q["ratio"])
-            return "none" if best is None else f"{best[1]:.2f} -> {best[2]:.2f} (x{best[0]:.1f})"
+            pts = [p for p in sweeps if p["lambda"] == lv and p["direction"] == direction]
+            at = next((k for k, p in enumerate(pts) if p["jump"]), None)
+            if at is None or at + 1 >= len(pts):
+                return "none"
+            p, q = pts[at], pts[at + 1]
+            change = max(p["x"] / q["x"], q["x"] / p["x"])
+            return f"{p['ratio']:.2f} -> {q['ratio']:.2f} (x{change:.1f})"
         unsettled = sum(1 for p in sweeps if p["lambda"] == lv and not p["settled"])
         lines.append(
             f"| {lv:.4g} | {d['kappa_data'][i]:.3f} | {d['kappa_nsd'][i]:.3f} "

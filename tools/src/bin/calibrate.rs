@@ -65,7 +65,8 @@ struct Args {
     #[arg(long, default_value_t = 2.5)]
     highest: f64,
     /// shallow-water source: write every swept point as CSV to this file (columns
-    /// lambda,direction,ratio,x,phase,x_peak,zeta_eq,cycles,settled)
+    /// lambda,direction,ratio,x,phase,x_peak,zeta_eq,cycles,settled,jump; jump is 1 on the last
+    /// point before the sweep jumps)
     #[arg(long, value_name = "OUT")]
     sweeps: Option<String>,
     /// write the samples with the fitted model as CSV to OUT (columns
@@ -333,12 +334,16 @@ fn shallow_water(o: &Args, tank: &Tank, lambdas: &[f64]) -> Result<Vec<Character
 
 /// Every swept point as CSV.
 fn write_sweeps(path: &str, found: &[Characteristic]) -> Result<(), String> {
-    let mut text = String::from("lambda,direction,ratio,x,phase,x_peak,zeta_eq,cycles,settled\n");
+    let mut text =
+        String::from("lambda,direction,ratio,x,phase,x_peak,zeta_eq,cycles,settled,jump\n");
     for c in found {
-        for (direction, points) in [("up", &c.up), ("down", &c.down)] {
+        for (direction, points, jump) in [("up", &c.up, c.jump_down), ("down", &c.down, c.jump_up)]
+        {
+            // 1 on the last point before the sweep's jump (analysis::sweep::jump's)
+            let before = jump.map(|(b, _)| b.ratio);
             for r in points.iter() {
                 text.push_str(&format!(
-                    "{},{direction},{:.6},{},{},{},{},{},{}\n",
+                    "{},{direction},{:.6},{},{},{},{},{},{},{}\n",
                     c.lambda,
                     r.ratio,
                     r.x,
@@ -346,7 +351,8 @@ fn write_sweeps(path: &str, found: &[Characteristic]) -> Result<(), String> {
                     r.x_peak,
                     r.zeta_eq,
                     r.cycles,
-                    u8::from(r.settled)
+                    u8::from(r.settled),
+                    u8::from(before == Some(r.ratio))
                 ));
             }
         }
@@ -394,6 +400,15 @@ mod tests {
         let text = std::fs::read_to_string(&csv).expect("read");
         let points: usize = found.iter().map(|c| c.up.len() + c.down.len()).sum();
         assert_eq!(text.lines().count(), 1 + points);
+        // A point is marked before a jump exactly when the sweep found one.
+        let jumps = found
+            .iter()
+            .map(|c| usize::from(c.jump_down.is_some()) + usize::from(c.jump_up.is_some()))
+            .sum::<usize>();
+        assert_eq!(
+            text.lines().skip(1).filter(|l| l.ends_with(",1")).count(),
+            jumps
+        );
         let _ = std::fs::remove_file(&csv);
     }
 
