@@ -23,7 +23,7 @@ mod tests;
 
 use crate::physics::base::BaseAcceleration;
 use crate::solver::SolveError;
-use scheme::{Faces, Grid, March, Rates, lane_sum, rates, sweep_into, velocity};
+use scheme::{Faces, Grid, March, Rates, lane_sum, lane_sum_by, rates, sweep_passes, velocity};
 
 /// Courant number of a substep against the largest interface wave speed. The MUSCL-HLL
 /// forward-Euler stage keeps depths non-negative up to 1/2 (each cell average is the mean of
@@ -93,40 +93,31 @@ impl Channel {
 
     /// The liquid volume per unit breadth [m^2].
     pub fn volume(&self, f: &Flow) -> f64 {
-        f.depth.iter().sum::<f64>() * self.dx()
+        lane_sum(&f.depth) * self.dx()
     }
 
     /// The liquid momentum per unit breadth and density, integral of q [m^3/s].
     pub fn momentum(&self, f: &Flow) -> f64 {
-        f.discharge.iter().sum::<f64>() * self.dx()
+        lane_sum(&f.discharge) * self.dx()
     }
 
     /// First moment of the depth about the tank centre, integral of H (x - a/2) [m^3]: the
     /// volume times the centre of mass's offset.
     pub fn moment(&self, f: &Flow) -> f64 {
         let mid = 0.5 * self.length;
-        let dx = self.dx();
-        f.depth
-            .iter()
-            .enumerate()
-            .map(|(i, h)| h * (self.centre(i) - mid))
-            .sum::<f64>()
-            * dx
+        let h = &f.depth[..self.cells];
+        lane_sum_by(h.len(), |i| h[i] * (self.centre(i) - mid)) * self.dx()
     }
 
     /// Mechanical energy per unit breadth and density, integral of q^2/(2H) + g_e (H-h)^2/2
     /// [m^4/s^2] (the kinetic part with the desingularised velocity, 0 in a dry cell).
     pub fn energy(&self, f: &Flow) -> f64 {
         let dry = DRY * self.depth;
-        f.depth
-            .iter()
-            .zip(&f.discharge)
-            .map(|(&h, &q)| {
-                let eta = h - self.depth;
-                0.5 * q * velocity(q, h, dry) + 0.5 * self.g_e * eta * eta
-            })
-            .sum::<f64>()
-            * self.dx()
+        let (h, q) = (&f.depth[..self.cells], &f.discharge[..self.cells]);
+        lane_sum_by(h.len(), |i| {
+            let eta = h[i] - self.depth;
+            0.5 * q[i] * velocity(q[i], h[i], dry) + 0.5 * self.g_e * eta * eta
+        }) * self.dx()
     }
 
     /// Depth at the walls x = 0 and x = a: extrapolated linearly from the two cells next to
@@ -183,6 +174,100 @@ impl Channel {
         c: f64,
         most: u64,
     ) -> Result<Advanced, SolveError> {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                // SAFETY: advance_avx512 only needs AVX-512F, which this CPU has (just checked).
+                return unsafe { self.advance_avx512(w, f, h, base, c, most) };
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: advance_avx2 only needs AVX2, which this CPU has (just checked).
+                return unsafe { self.advance_avx2(w, f, h, base, c, most) };
+            }
+        }
+        self.advance_passes(w, f, h, base, c, most)
+    }
+
+    /// Every build of [`Channel::advance_in`] this CPU can run, by name, each on a copy of
+    /// `f` (the tests compare them).
+    #[cfg(test)]
+    pub(super) fn each_build(
+        &self,
+        f: &Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+    ) -> Vec<(&'static str, Result<Advanced, SolveError>, Flow)> {
+        let mut w = Scratch::new(self.cells);
+        let mut out = vec![];
+        let mut g = f.clone();
+        out.push((
+            "baseline",
+            self.advance_passes(&mut w, &mut g, h, base, c, u64::MAX),
+            g,
+        ));
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                let mut g = f.clone();
+                // SAFETY: this CPU has AVX2 (just checked).
+                let r = unsafe { self.advance_avx2(&mut w, &mut g, h, base, c, u64::MAX) };
+                out.push(("avx2", r, g));
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                let mut g = f.clone();
+                // SAFETY: this CPU has AVX-512F (just checked).
+                let r = unsafe { self.advance_avx512(&mut w, &mut g, h, base, c, u64::MAX) };
+                out.push(("avx512f", r, g));
+            }
+        }
+        out
+    }
+
+    /// [`Channel::advance_passes`] compiled for AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    fn advance_avx512(
+        &self,
+        w: &mut Scratch,
+        f: &mut Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+        most: u64,
+    ) -> Result<Advanced, SolveError> {
+        self.advance_passes(w, f, h, base, c, most)
+    }
+
+    /// [`Channel::advance_passes`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn advance_avx2(
+        &self,
+        w: &mut Scratch,
+        f: &mut Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+        most: u64,
+    ) -> Result<Advanced, SolveError> {
+        self.advance_passes(w, f, h, base, c, most)
+    }
+
+    /// The substeps of [`Channel::advance_in`], for any CPU (the baseline build): compiled
+    /// whole, the scheme's passes included, for each instruction set the CPU may have, and
+    /// the widest chosen once per communication step (the same operations in the same order
+    /// in every build, no fused multiply-adds: the same bits, tested).
+    #[inline(always)]
+    fn advance_passes(
+        &self,
+        w: &mut Scratch,
+        f: &mut Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+        most: u64,
+    ) -> Result<Advanced, SolveError> {
         let grid = self.grid();
         let dx = grid.dx;
         let mut done = Advanced::default();
@@ -229,6 +314,7 @@ impl Channel {
     }
 
     /// Largest |u| + sqrt(g_e H) of the cell averages.
+    #[inline(always)]
     fn cell_speed(&self, f: &Flow) -> f64 {
         let dry = DRY * self.depth;
         let speed = |h: f64, q: f64| velocity(q, h, dry).abs() + (self.g_e * h.max(0.0)).sqrt();
@@ -252,6 +338,7 @@ impl Channel {
     /// One substep dt from time t: drag dt/2 exactly, SSPRK(10,4) (Ketcheson 2008) on the
     /// hyperbolic part and the inertial force, drag dt/2 (Strang: second order, and the drag
     /// never limits the step). Err(speed): a stage met a wave too fast for dt; nothing changed.
+    #[inline(always)]
     fn substep(
         &self,
         f: &mut Flow,
@@ -305,7 +392,7 @@ impl Channel {
                 sum: [&mut sum_h[..n], &mut sum_q[..n]],
             };
             let (hk, qk): (&[f64], &[f64]) = if k == 0 { (h0, q0) } else { (h1, q1) };
-            let s = sweep_into(&grid, hk, qk, a, faces, Some(&mut march));
+            let s = sweep_passes(&grid, hk, qk, a, faces, Some(&mut march));
             std::mem::swap(h1, next_h);
             std::mem::swap(q1, next_q);
             if k == RESTART {

@@ -267,15 +267,21 @@ fn whole_chunks(len: usize) -> impl Iterator<Item = std::ops::Range<usize>> {
 /// dependent additions as long as `x` (which a sum in order is, at 3-4 cycles an addition).
 #[inline(always)]
 pub fn lane_sum(x: &[f64]) -> f64 {
+    lane_sum_by(x.len(), |i| x[i])
+}
+
+/// The sum of `term(i)` for i in 0..n, in eight lanes as [`lane_sum`].
+#[inline(always)]
+pub fn lane_sum_by(n: usize, term: impl Fn(usize) -> f64) -> f64 {
     let mut lanes = [0.0; 8];
-    let mut chunks = x.chunks_exact(8);
-    for c in &mut chunks {
-        for (l, &v) in lanes.iter_mut().zip(c) {
-            *l += v;
+    let whole = n - n % 8;
+    for k in (0..whole).step_by(8) {
+        for (j, l) in lanes.iter_mut().enumerate() {
+            *l += term(k + j);
         }
     }
-    for (l, &v) in lanes.iter_mut().zip(chunks.remainder()) {
-        *l += v;
+    for (j, l) in lanes.iter_mut().enumerate().take(n - whole) {
+        *l += term(whole + j);
     }
     let [a, b, c, d, e, f, g, h] = lanes;
     ((a + e) + (c + g)) + ((b + f) + (d + h))
@@ -387,30 +393,18 @@ impl Faces {
 /// operations on the same numbers in the same order (no fused multiply-adds, nothing
 /// reassociated): the results are bit for bit those of the baseline build (tested).
 pub fn sweep(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
-    sweep_into(grid, h, q, a, faces, None)
-}
-
-/// [`sweep`], the rates going to `march` if given (then [`Faces::rates`] is not written).
-pub fn sweep_into(
-    grid: &Grid,
-    h: &[f64],
-    q: &[f64],
-    a: f64,
-    faces: &mut Faces,
-    march: Option<&mut March>,
-) -> Sweep {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
             // SAFETY: sweep_avx512 only needs AVX-512F, which this CPU has (just checked).
-            return unsafe { sweep_avx512(grid, h, q, a, faces, march) };
+            return unsafe { sweep_avx512(grid, h, q, a, faces, None) };
         }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: sweep_avx2 only needs AVX2, which this CPU has (just checked).
-            return unsafe { sweep_avx2(grid, h, q, a, faces, march) };
+            return unsafe { sweep_avx2(grid, h, q, a, faces, None) };
         }
     }
-    sweep_passes(grid, h, q, a, faces, march)
+    sweep_passes(grid, h, q, a, faces, None)
 }
 
 /// Every build of [`sweep_passes`] this CPU can run, by name, each given to `check` with what
@@ -493,9 +487,11 @@ fn sweep_avx2(
     sweep_passes(grid, h, q, a, faces, march)
 }
 
-/// The passes of [`sweep`], for any CPU (the baseline build).
+/// The passes of [`sweep`], for any CPU (the baseline build); the rates go to `march` if
+/// given (then [`Faces::rates`] is not written). Inlined into the builds of a whole
+/// communication step ([`super::Channel::advance_in`]) too.
 #[inline(always)]
-fn sweep_passes(
+pub(super) fn sweep_passes(
     grid: &Grid,
     h: &[f64],
     q: &[f64],
@@ -569,9 +565,10 @@ fn sweep_passes(
     }
     // No mass flux through the walls (by symmetry; the formula leaves rounding there).
     (mass[0], mass[n]) = (0.0, 0.0);
-    // The largest speed, in 4 lanes (the maximum does not depend on the order).
-    let mut lanes = [0.0; 4];
-    let mut chunks = speed.chunks_exact(4);
+    // The largest speed, in 16 lanes (the maximum does not depend on the order; 16: two
+    // independent chains of 8-lane maxima, not one of 4-lane ones twice as long).
+    let mut lanes = [0.0; 16];
+    let mut chunks = speed.chunks_exact(16);
     for c in &mut chunks {
         for (l, &s) in lanes.iter_mut().zip(c) {
             *l = faster(*l, s);
