@@ -581,3 +581,64 @@ fn an_hour_of_violent_sloshing_conserves_mass() {
     eprintln!("an hour: mass error {worst:e}");
     assert!(worst < 1e-13, "{worst:e}");
 }
+
+/// The wall depths: extrapolated linearly from the two cells next to each wall (1.5 H_0 -
+/// 0.5 H_1), not below 0; a single cell is its own wall depth on both sides.
+#[test]
+fn wall_depths_extrapolate_the_two_wall_cells() {
+    let two = lab(2);
+    let f = Flow {
+        depth: vec![0.03, 0.02],
+        discharge: vec![0.0; 2],
+    };
+    let [l, r] = two.wall_depths(&f);
+    assert!(
+        (l - 0.035).abs() < 1e-15 && (r - 0.015).abs() < 1e-15,
+        "{l} {r}"
+    );
+    let steep = Flow {
+        depth: vec![0.03, 0.001],
+        discharge: vec![0.0; 2],
+    };
+    assert_eq!(two.wall_depths(&steep)[1], 0.0);
+    let one = lab(1);
+    let f = Flow {
+        depth: vec![0.02],
+        discharge: vec![0.0],
+    };
+    assert_eq!(one.wall_depths(&f), [0.02, 0.02]);
+}
+
+/// A film is dry only below DRY times the still depth (2.1e-11 m in the lab tank): a film of
+/// 1 nm moving at 0.1 m/s is liquid, with the kinetic energy q^2/(2H) per unit area, and keeps
+/// its momentum through a step (the walls reverse only the end cells'), at the CFL step its
+/// velocity sets.
+#[test]
+fn a_film_above_the_dry_depth_is_liquid() {
+    let ch = lab(16);
+    let (h, u) = (1e-9, 0.1);
+    let film = Flow {
+        depth: vec![h; 16],
+        discharge: vec![h * u; 16],
+    };
+    let potential = 0.5 * ch.g_e * (h - ch.depth).powi(2) * ch.length;
+    let kinetic = ch.energy(&film) - potential;
+    let exact = 0.5 * h * u * u * ch.length;
+    assert!(
+        (kinetic / exact - 1.0).abs() < 1e-6,
+        "{kinetic:e} vs {exact:e}"
+    );
+    let mut f = film.clone();
+    let d = ch
+        .advance(&mut f, 1e-3, &held(0.0), 0.0, 1_000)
+        .expect("step");
+    let (before, after) = (ch.momentum(&film), ch.momentum(&f));
+    assert!(after > 0.5 * before, "{after:e} of {before:e}");
+    assert_eq!(d.rejected, 0, "{d:?}");
+    // The CFL speed of the cells sees the film's velocity: a step of 1 s is cut into substeps
+    // short enough from the start, none taken again.
+    let d = ch
+        .advance(&mut film.clone(), 1.0, &held(0.0), 0.0, 1_000)
+        .expect("step");
+    assert!(d.substeps > 1 && d.rejected == 0, "{d:?}");
+}
