@@ -642,3 +642,24 @@ fn a_film_above_the_dry_depth_is_liquid() {
         .expect("step");
     assert!(d.substeps > 1 && d.rejected == 0, "{d:?}");
 }
+
+/// The substeps follow the CFL condition from the cells' speeds: still water, whose waves all
+/// run at c0 = sqrt(g_e h), takes ceil(h / (CFL dx / c0)) equal substeps, none taken again;
+/// and through the bores and dry walls of violent forcing, the cells' speed at the start of a
+/// step and the stages' speeds after keep retried substeps rare.
+#[test]
+fn substeps_follow_the_cfl_condition() {
+    let ch = lab(40);
+    let c0 = (ch.g_e * ch.depth).sqrt();
+    let h = 0.1;
+    let expected = (h / (CFL * ch.dx() / c0)).ceil() as u64;
+    let d = ch
+        .advance(&mut ch.at_rest(), h, &held(0.0), 0.0, 1_000)
+        .expect("step");
+    assert_eq!((d.substeps, d.rejected), (expected, 0), "{d:?}");
+    let run = violent(40, 300, 0.01, 0.1);
+    let substeps: u64 = run.iter().map(|(_, d, _)| d.substeps).sum();
+    let rejected: u64 = run.iter().map(|(_, d, _)| d.rejected).sum();
+    eprintln!("violent: {substeps} substeps, {rejected} taken again");
+    assert!(rejected * 100 <= substeps, "{rejected} of {substeps}");
+}
