@@ -661,6 +661,14 @@ fn substeps_follow_the_cfl_condition() {
         .advance(&mut ch.at_rest(), h, &held(0.0), 0.0, 1_000)
         .expect("step");
     assert_eq!((d.substeps, d.rejected), (expected, 0), "{d:?}");
+    // solver.max_substeps: exactly as many as the step needs pass, one fewer is refused.
+    let exactly = ch.advance(&mut ch.at_rest(), h, &held(0.0), 0.0, expected);
+    assert!(exactly.is_ok(), "{exactly:?}");
+    let fewer = ch.advance(&mut ch.at_rest(), h, &held(0.0), 0.0, expected - 1);
+    assert!(
+        matches!(fewer, Err(SolveError::TooManySteps { .. })),
+        "{fewer:?}"
+    );
     let run = violent(40, 300, 0.01, 0.1);
     let substeps: u64 = run.iter().map(|(_, d, _)| d.substeps).sum();
     let rejected: u64 = run.iter().map(|(_, d, _)| d.rejected).sum();
