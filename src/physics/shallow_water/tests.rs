@@ -713,3 +713,22 @@ fn films_below_the_dry_depth_stop() {
     let p = ch.momentum(&film);
     assert!((d.impulse / p - 1.0).abs() < 1e-12, "{} vs {p}", d.impulse);
 }
+
+/// The desingularised velocity (Kurganov & Petrova 2007): q/H exactly down to the dry depth,
+/// continuous there, below it never above q/dry and going to 0 with the depth.
+#[test]
+fn the_velocity_is_desingularised_below_the_dry_depth() {
+    let (dry, q) = (1e-6, 3e-7);
+    assert_eq!(scheme::velocity(q, 2e-6, dry), q / 2e-6);
+    assert_eq!(scheme::velocity(q, dry, dry), q / dry);
+    let below = scheme::velocity(q, dry * (1.0 - 1e-9), dry);
+    assert!((below / (q / dry) - 1.0).abs() < 1e-8, "{below:e}");
+    let mut last = below;
+    for k in 1..=10 {
+        let h = dry * (1.0 - 0.1 * f64::from(k));
+        let u = scheme::velocity(q, h, dry);
+        assert!(u < last && u >= 0.0, "{h:e}: {u:e} after {last:e}");
+        last = u;
+    }
+    assert_eq!(last, 0.0);
+}
