@@ -240,18 +240,21 @@ fn fluxes(
 
 /// 0..len as one range of a whole number of chunks of W and, if len is not a multiple of W,
 /// the last W elements again (overlapping the first range, whose elements there it computes
-/// again from the same inputs, to the same bits); below W elements, 0..len. A loop over each
+/// again from the same inputs, to the same bits); below W elements, 0..len; for none, no range
+/// (a pass over the interior cells of one cell must not read its neighbours). A loop over each
 /// then runs whole vectors only, no scalar remainder (at 200 cells, the remainders of the
 /// face and flux passes cost about as much as three chunks of eight).
 fn whole_chunks(len: usize) -> impl Iterator<Item = std::ops::Range<usize>> {
     let rest = len % W;
-    // Below W elements, or a whole number of chunks: one range.
-    let (first, tail) = if len < W || rest == 0 {
-        (0..len, None)
+    // None for no elements; below W elements, or a whole number of chunks, one range.
+    let (first, tail) = if len == 0 {
+        (None, None)
+    } else if len < W || rest == 0 {
+        (Some(0..len), None)
     } else {
-        (0..len - rest, Some(len - W..len))
+        (Some(0..len - rest), Some(len - W..len))
     };
-    std::iter::once(first).chain(tail)
+    first.into_iter().chain(tail)
 }
 
 /// The sum of `x` in eight lanes, element i into lane i mod 8, the lanes then added pairwise
