@@ -212,6 +212,22 @@ fn mirrored_flows_evolve_mirrored() {
         dry_steps += usize::from(f.depth.iter().any(|&h| h < 1e-3 * ch.depth));
     }
     assert!(dry_steps > 10, "{dry_steps} steps with dry cells");
+    // One cell moving, and its mirror: the wall faces of a single cell reversed too.
+    let one = lab(1);
+    let f0 = Flow {
+        depth: vec![one.depth],
+        discharge: vec![0.1 * one.depth],
+    };
+    let (mut f, mut g) = (f0.clone(), mirror(&f0));
+    for _ in 0..20 {
+        one.advance(&mut f, 0.01, &held(0.0), 0.0, 1_000)
+            .expect("step");
+        one.advance(&mut g, 0.01, &held(0.0), 0.0, 1_000)
+            .expect("mirrored step");
+        let m = mirror(&f);
+        assert!(m.depth == g.depth && m.discharge == g.discharge, "one cell");
+    }
+    assert!(f.discharge[0] != 0.0);
 }
 
 /// One cell (the scheme takes any count from one; the FMU from four): the tilted lake at rest
