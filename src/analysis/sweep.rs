@@ -90,8 +90,10 @@ impl Sweeper {
         if !(amplitude.is_finite() && amplitude > 0.0) {
             return Err(format!("the base amplitude {amplitude} m must be positive"));
         }
-        if settling.steps_per_cycle < 8 || settling.measure_cycles == 0 {
-            return Err("at least 8 steps per cycle and one measured cycle".into());
+        if settling.steps_per_cycle < 8 || settling.measure_cycles == 0 || settling.max_cycles < 8 {
+            return Err(
+                "at least 8 steps per cycle, one measured cycle and 8 cycles to settle in".into(),
+            );
         }
         let (common, _) = Common::read(p)?;
         let (damper, _) = Damper::configure(p)?;
@@ -108,6 +110,11 @@ impl Sweeper {
 
     pub fn omega_f(&self) -> f64 {
         self.omega_f
+    }
+
+    /// Simulated time run so far [s].
+    pub fn time(&self) -> f64 {
+        self.time
     }
 
     /// Run one cycle at `w` [rad/s] from the current state.
@@ -165,12 +172,7 @@ impl Sweeper {
             let cycle = self.cycle(w)?;
             history.push(cycle.x);
             let zeta = self.zeta_eq(cycle.energy, w, cycle.x);
-            let decay = (1.0 / (2.0 * PI * zeta)).ceil();
-            let beat = (1.5 / (1.0 - ratio).abs()).ceil().min(40.0);
-            let window = decay
-                .max(beat)
-                .clamp(4.0, f64::from(self.settling.max_cycles / 2));
-            let window = window as usize;
+            let window = settling_window(zeta, ratio, self.settling.max_cycles);
             if history.len() >= window {
                 let recent = &history[history.len() - window..];
                 let (lo, hi) = recent.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &x| {
@@ -275,8 +277,7 @@ pub fn characterise(
         let r = sweeper.respond(plan.from + plan.step * k as f64)?;
         up.push(r);
         let top = peak(&up).map_or(0.0, |p| p.x);
-        let past = r.x < 0.5 * top || r.phase > 0.75 * PI;
-        below = if past { below + 1 } else { 0 };
+        below = if past_peak(&r, top) { below + 1 } else { 0 };
         if below == 3 {
             break;
         }
@@ -301,6 +302,24 @@ pub fn characterise(
         up,
         down,
     })
+}
+
+/// The cycles over which a response must stay within the tolerance to count as settled at
+/// damping `zeta` and frequency ratio `ratio`: one e-fold of a transient's decay,
+/// 1/(2 pi zeta) cycles, or one and a half beats of the free motion against the forcing,
+/// 1.5/abs(1 - ratio) cycles (at most 40), whichever is longer, rounded up; at least 4, at most
+/// half of `max_cycles`.
+pub fn settling_window(zeta: f64, ratio: f64, max_cycles: u32) -> usize {
+    let decay = (1.0 / (2.0 * PI * zeta)).ceil();
+    let beat = (1.5 / (1.0 - ratio).abs()).ceil().min(40.0);
+    decay.max(beat).clamp(4.0, f64::from(max_cycles / 2)) as usize
+}
+
+/// Whether an up-sweep's response `r` is past the peak `top` (the largest amplitude so far): its
+/// amplitude below half of it (on the lower branch) or its lag beyond 3 pi/4 (well past
+/// quadrature).
+pub fn past_peak(r: &Response, top: f64) -> bool {
+    r.x < 0.5 * top || r.phase > 0.75 * PI
 }
 
 /// `n` ratios from `from` to `to`, evenly spaced, both included (n >= 2).

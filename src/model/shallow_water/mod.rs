@@ -7,7 +7,7 @@
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
 use crate::description::vr;
 use crate::physics::shallow_water::scheme::velocity;
-use crate::physics::shallow_water::{Channel, DRY, Flow, Scratch};
+use crate::physics::shallow_water::{Channel, DRY, Flow, STAGE_COUNT, Scratch};
 use crate::solver::SolveStats;
 use std::f64::consts::PI;
 
@@ -180,8 +180,8 @@ impl Model for ShallowWater {
         let stats = SolveStats {
             accepted: done.substeps,
             rejected: done.rejected,
-            // Three right-hand sides per SSPRK3 substep, taken or not.
-            evaluations: 3 * (done.substeps + done.rejected),
+            // STAGE_COUNT right-hand sides per substep, taken or not.
+            evaluations: STAGE_COUNT * (done.substeps + done.rejected),
         };
         Ok(Stepped {
             stats,

@@ -7,8 +7,8 @@
 //! ```
 //!
 //! solved by a second-order Godunov-type finite-volume scheme ([`scheme`]: limited
-//! reconstruction, HLL fluxes, well balanced and positivity preserving), SSPRK3 in time, the
-//! drag integrated exactly by Strang splitting. Per unit of rho b throughout: the model
+//! reconstruction, HLL fluxes, well balanced and positivity preserving), SSPRK(10,4) in time,
+//! the drag integrated exactly by Strang splitting. Per unit of rho b throughout: the model
 //! multiplies by the density, the breadth and the tanks.
 //!
 //! The time step: each substep is the CFL step; the communication step's remainder is divided
@@ -23,15 +23,16 @@ mod tests;
 
 use crate::physics::base::BaseAcceleration;
 use crate::solver::SolveError;
-use scheme::{Faces, Grid, Rates, rates, sweep, velocity};
+use scheme::{Faces, Grid, March, Rates, lane_sum, lane_sum_by, rates, sweep_passes, velocity};
 
 /// Courant number of a substep against the largest interface wave speed. The MUSCL-HLL
 /// forward-Euler stage keeps depths non-negative up to 1/2 (each cell average is the mean of
 /// its two face values, each updated by a first-order HLL step at twice the Courant number);
-/// SSPRK3 is a convex combination of such stages.
-pub const CFL: f64 = 0.45;
-/// The positivity bound itself: a substep whose stages meet a faster wave than this allows is
-/// taken again, shorter.
+/// SSPRK(10,4) is a convex combination of such stages of dt/6: 0.45 per stage, 2.7 per
+/// substep.
+pub const CFL: f64 = 0.45 * RATIO;
+/// The positivity bound itself, per forward-Euler stage: a substep whose stages meet a faster
+/// wave than this allows is taken again, shorter.
 const CFL_BOUND: f64 = 0.5;
 
 /// The still-water depth below which a cell is dry, relative to the still depth: its liquid
@@ -92,40 +93,31 @@ impl Channel {
 
     /// The liquid volume per unit breadth [m^2].
     pub fn volume(&self, f: &Flow) -> f64 {
-        f.depth.iter().sum::<f64>() * self.dx()
+        lane_sum(&f.depth) * self.dx()
     }
 
     /// The liquid momentum per unit breadth and density, integral of q [m^3/s].
     pub fn momentum(&self, f: &Flow) -> f64 {
-        f.discharge.iter().sum::<f64>() * self.dx()
+        lane_sum(&f.discharge) * self.dx()
     }
 
     /// First moment of the depth about the tank centre, integral of H (x - a/2) [m^3]: the
     /// volume times the centre of mass's offset.
     pub fn moment(&self, f: &Flow) -> f64 {
         let mid = 0.5 * self.length;
-        let dx = self.dx();
-        f.depth
-            .iter()
-            .enumerate()
-            .map(|(i, h)| h * (self.centre(i) - mid))
-            .sum::<f64>()
-            * dx
+        let h = &f.depth[..self.cells];
+        lane_sum_by(h.len(), |i| h[i] * (self.centre(i) - mid)) * self.dx()
     }
 
     /// Mechanical energy per unit breadth and density, integral of q^2/(2H) + g_e (H-h)^2/2
     /// [m^4/s^2] (the kinetic part with the desingularised velocity, 0 in a dry cell).
     pub fn energy(&self, f: &Flow) -> f64 {
         let dry = DRY * self.depth;
-        f.depth
-            .iter()
-            .zip(&f.discharge)
-            .map(|(&h, &q)| {
-                let eta = h - self.depth;
-                0.5 * q * velocity(q, h, dry) + 0.5 * self.g_e * eta * eta
-            })
-            .sum::<f64>()
-            * self.dx()
+        let (h, q) = (&f.depth[..self.cells], &f.discharge[..self.cells]);
+        lane_sum_by(h.len(), |i| {
+            let eta = h[i] - self.depth;
+            0.5 * q[i] * velocity(q[i], h[i], dry) + 0.5 * self.g_e * eta * eta
+        }) * self.dx()
     }
 
     /// Depth at the walls x = 0 and x = a: extrapolated linearly from the two cells next to
@@ -182,6 +174,100 @@ impl Channel {
         c: f64,
         most: u64,
     ) -> Result<Advanced, SolveError> {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                // SAFETY: advance_avx512 only needs AVX-512F, which this CPU has (just checked).
+                return unsafe { self.advance_avx512(w, f, h, base, c, most) };
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: advance_avx2 only needs AVX2, which this CPU has (just checked).
+                return unsafe { self.advance_avx2(w, f, h, base, c, most) };
+            }
+        }
+        self.advance_passes(w, f, h, base, c, most)
+    }
+
+    /// Every build of [`Channel::advance_in`] this CPU can run, by name, each on a copy of
+    /// `f` (the tests compare them).
+    #[cfg(test)]
+    pub(super) fn each_build(
+        &self,
+        f: &Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+    ) -> Vec<(&'static str, Result<Advanced, SolveError>, Flow)> {
+        let mut w = Scratch::new(self.cells);
+        let mut out = vec![];
+        let mut g = f.clone();
+        out.push((
+            "baseline",
+            self.advance_passes(&mut w, &mut g, h, base, c, u64::MAX),
+            g,
+        ));
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                let mut g = f.clone();
+                // SAFETY: this CPU has AVX2 (just checked).
+                let r = unsafe { self.advance_avx2(&mut w, &mut g, h, base, c, u64::MAX) };
+                out.push(("avx2", r, g));
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                let mut g = f.clone();
+                // SAFETY: this CPU has AVX-512F (just checked).
+                let r = unsafe { self.advance_avx512(&mut w, &mut g, h, base, c, u64::MAX) };
+                out.push(("avx512f", r, g));
+            }
+        }
+        out
+    }
+
+    /// [`Channel::advance_passes`] compiled for AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    fn advance_avx512(
+        &self,
+        w: &mut Scratch,
+        f: &mut Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+        most: u64,
+    ) -> Result<Advanced, SolveError> {
+        self.advance_passes(w, f, h, base, c, most)
+    }
+
+    /// [`Channel::advance_passes`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn advance_avx2(
+        &self,
+        w: &mut Scratch,
+        f: &mut Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+        most: u64,
+    ) -> Result<Advanced, SolveError> {
+        self.advance_passes(w, f, h, base, c, most)
+    }
+
+    /// The substeps of [`Channel::advance_in`], for any CPU (the baseline build): compiled
+    /// whole, the scheme's passes included, for each instruction set the CPU may have, and
+    /// the widest chosen once per communication step (the same operations in the same order
+    /// in every build, no fused multiply-adds: the same bits, tested).
+    #[inline(always)]
+    fn advance_passes(
+        &self,
+        w: &mut Scratch,
+        f: &mut Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+        most: u64,
+    ) -> Result<Advanced, SolveError> {
         let grid = self.grid();
         let dx = grid.dx;
         let mut done = Advanced::default();
@@ -228,18 +314,31 @@ impl Channel {
     }
 
     /// Largest |u| + sqrt(g_e H) of the cell averages.
+    #[inline(always)]
     fn cell_speed(&self, f: &Flow) -> f64 {
         let dry = DRY * self.depth;
-        f.depth
-            .iter()
-            .zip(&f.discharge)
-            .map(|(&h, &q)| velocity(q, h, dry).abs() + (self.g_e * h.max(0.0)).sqrt())
-            .fold(0.0, f64::max)
+        let speed = |h: f64, q: f64| velocity(q, h, dry).abs() + (self.g_e * h.max(0.0)).sqrt();
+        // In eight lanes, without branches (vectorised); a NaN is passed over, as f64::max
+        // does (the step then refuses the state).
+        let faster = |m: f64, s: f64| if s > m { s } else { m };
+        let mut lanes = [0.0; 8];
+        let (hs, qs) = (f.depth.chunks_exact(8), f.discharge.chunks_exact(8));
+        let rest = hs.remainder().iter().zip(qs.remainder());
+        for (h, q) in hs.zip(qs) {
+            for ((l, &h), &q) in lanes.iter_mut().zip(h).zip(q) {
+                *l = faster(*l, speed(h, q));
+            }
+        }
+        for (l, (&h, &q)) in lanes.iter_mut().zip(rest) {
+            *l = faster(*l, speed(h, q));
+        }
+        lanes.into_iter().fold(0.0, faster)
     }
 
-    /// One substep dt from time t: drag dt/2 exactly, SSPRK3 (Shu & Osher 1988) on the
+    /// One substep dt from time t: drag dt/2 exactly, SSPRK(10,4) (Ketcheson 2008) on the
     /// hyperbolic part and the inertial force, drag dt/2 (Strang: second order, and the drag
     /// never limits the step). Err(speed): a stage met a wave too fast for dt; nothing changed.
+    #[inline(always)]
     fn substep(
         &self,
         f: &mut Flow,
@@ -251,15 +350,14 @@ impl Channel {
     ) -> Result<Substep, f64> {
         let grid = self.grid();
         let dx = grid.dx;
-        let limit = CFL_BOUND * dx / dt;
+        let limit = CFL_BOUND * dx / (dt / RATIO);
         let decay = (-0.5 * c * dt).exp();
         // The drag's impulse on the tank is the momentum it takes from the liquid: (1 - decay)
-        // times the momentum (the sum of the discharges, in order, times dx) before each half.
+        // times the momentum (the sum of the discharges times dx) before each half.
         let drag_loss = |p: f64| (1.0 - decay) * p;
         // U0 = the state after the first drag half: the depths are f's.
-        let mut p0 = -0.0;
+        let p0 = lane_sum(&f.discharge);
         for (a, &q) in w.q0.iter_mut().zip(&f.discharge) {
-            p0 += q;
             *a = q * decay;
         }
         let mut impulse = drag_loss(p0 * dx);
@@ -271,68 +369,84 @@ impl Channel {
             q0,
             h1,
             q1,
-            h2,
-            q2,
+            next_h,
+            next_q,
+            sum_h,
+            sum_q,
             faces,
         } = w;
         let (h0, q0) = (&f.depth[..n], &q0[..n]);
-        for (k, &(at, weight, beta)) in STAGES.iter().enumerate() {
-            let a = base.at(t + at * dt);
-            // U_k, and where U_k+1 goes: the last stage writes over U_1 (no longer needed),
-            // so that f changes only once the substep is accepted.
-            let (hk, qk, hn, qn): (&[f64], &[f64], &mut [f64], &mut [f64]) = match k {
-                0 => (h0, q0, h1, q1),
-                1 => (h1, q1, h2, q2),
-                _ => (h2, q2, h1, q1),
+        // Register 1 (h1, q1) holds the state a stage's rates are taken at, A (sum_h, sum_q)
+        // the sum of the rates times their weights: the substep's increment. Both are
+        // written as increments (U1 + (dt/6) L, U0 + (2/3) A, U0 + A), never as combinations
+        // of whole states with weights that are not binary fractions: those round the same
+        // way substep after substep (mass drift). Each stage writes the next register 1
+        // beside the current one (next_h, next_q), and the two are swapped.
+        for (k, stage) in STAGES.iter().enumerate() {
+            let a = base.at(t + stage.at * dt);
+            let mut march = March {
+                ahead: stage.ahead * dt,
+                weight: stage.weight * dt,
+                first: k == 0,
+                next: [&mut next_h[..n], &mut next_q[..n]],
+                sum: [&mut sum_h[..n], &mut sum_q[..n]],
             };
-            // All of the cells' length: no bounds checks in the pass.
-            let (hk, qk, hn, qn) = (&hk[..n], &qk[..n], &mut hn[..n], &mut qn[..n]);
-            // Next stage: (1 - beta) U0 + beta (U_k + dt L(U_k)).
-            // Written as U0 + beta (U_k - U0 + dt L(U_k)): rounded, (1 - beta) U0 + beta U_k
-            // loses mass at a steady rate, for 1 - beta and beta are not binary fractions and
-            // U0 and U_k change little from substep to substep, so that their products round
-            // the same way again and again (+1e-15 of the liquid per simulated second at 40
-            // cells, 3.8e-12 in an hour: the hour test's 1e-13 failed). The increment form
-            // rounds only the small increment and one sum per cell: no drift.
-            let s = sweep(&grid, hk, qk, a, faces);
-            let (dh, dq) = faces.rates();
-            let depths = hn.iter_mut().zip(h0).zip(hk.iter().zip(dh));
-            for ((hn, &h0), (&hk, &dh)) in depths {
-                *hn = h0 + beta * ((hk - h0) + dt * dh);
-            }
-            let discharges = qn.iter_mut().zip(q0).zip(qk.iter().zip(dq));
-            for ((qn, &q0), (&qk, &dq)) in discharges {
-                *qn = q0 + beta * ((qk - q0) + dt * dq);
+            let (hk, qk): (&[f64], &[f64]) = if k == 0 { (h0, q0) } else { (h1, q1) };
+            let s = sweep_passes(&grid, hk, qk, a, faces, Some(&mut march));
+            std::mem::swap(h1, next_h);
+            std::mem::swap(q1, next_q);
+            if k == RESTART {
+                // U1 = U0 + (2/3) A: the convex combination 3/5 U0 + 2/5 U1 of the scheme.
+                for ((h1, &a), &h0) in h1.iter_mut().zip(sum_h.iter()).zip(h0) {
+                    *h1 = h0 + RESTART_SHARE * a;
+                }
+                for ((q1, &a), &q0) in q1.iter_mut().zip(sum_q.iter()).zip(q0) {
+                    *q1 = q0 + RESTART_SHARE * a;
+                }
             }
             fastest = fastest.max(s.speed);
             if s.speed > limit {
                 return Err(s.speed);
             }
-            wall += weight * dt * (s.wall[1] - s.wall[0]);
+            wall += stage.weight * dt * (s.wall[1] - s.wall[0]);
             // The inertial force's power on the discrete liquid: -a_b times the rate of its
             // first moment, dx times the interior mass fluxes. (The continuum's -a_b integral
             // q dx is the same; this discrete form is the one the scheme's energy is
             // consistent with, the pseudo-bottom a_b x/g_e entering the hydrostatic
             // reconstruction as a bottom does.)
-            work -= weight * dt * a * s.mass_flux * dx;
+            work -= stage.weight * dt * a * s.mass_flux * dx;
+        }
+        // U = U0 + A, into register 1 (swapped into the state below).
+        for ((h1, &a), &h0) in h1.iter_mut().zip(sum_h.iter()).zip(h0) {
+            *h1 = h0 + a;
+        }
+        for ((q1, &a), &q0) in q1.iter_mut().zip(sum_q.iter()).zip(q0) {
+            *q1 = q0 + a;
         }
         std::mem::swap(&mut f.depth, h1);
         std::mem::swap(&mut f.discharge, q1);
         impulse += wall;
         // The second drag half, then the films: a dry cell's discharge goes to the bottom.
         let dry = grid.dry;
-        let (mut p1, mut stopped) = (-0.0, 0.0);
+        let p1 = lane_sum(&f.discharge);
+        // Without branches (vectorised): finiteness, the drag, the shallowest depth.
         let mut finite = true;
-        for (h, q) in f.depth.iter_mut().zip(f.discharge.iter_mut()) {
-            finite &= h.is_finite() && q.is_finite();
-            p1 += *q;
+        let mut shallowest = f64::INFINITY;
+        for (h, q) in f.depth.iter().zip(f.discharge.iter_mut()) {
+            finite &= h.is_finite() & q.is_finite();
             *q *= decay;
-            // Round-off can leave a drained cell a few ulps below 0; the scheme's positivity
-            // guarantees the rest.
-            if *h < dry {
-                *h = h.max(0.0);
-                stopped += *q;
-                *q = 0.0;
+            shallowest = if *h < shallowest { *h } else { shallowest };
+        }
+        let mut stopped = 0.0;
+        if shallowest < dry {
+            for (h, q) in f.depth.iter_mut().zip(f.discharge.iter_mut()) {
+                // Round-off can leave a drained cell a few ulps below 0; the scheme's
+                // positivity guarantees the rest.
+                if *h < dry {
+                    *h = h.max(0.0);
+                    stopped += *q;
+                    *q = 0.0;
+                }
             }
         }
         impulse += drag_loss(p1 * dx);
@@ -346,15 +460,48 @@ impl Channel {
     }
 }
 
-/// SSPRK3 in Shu-Osher form (Shu & Osher 1988), per stage: its time in the substep (a fraction
-/// of dt), its weight in the final combination, and beta of U_k+1 = (1 - beta) U0 + beta (U_k +
-/// dt L(U_k)). The stage times t, t + dt, t + dt/2 with the weights 1/6, 1/6, 2/3 are
-/// Simpson's rule: the work and the inertial impulse of a quadratic a_b are integrated
-/// exactly.
-const STAGES: [(f64, f64, f64); 3] = [
-    (0.0, 1.0 / 6.0, 1.0),
-    (1.0, 1.0 / 6.0, 0.25),
-    (0.5, 2.0 / 3.0, 2.0 / 3.0),
+/// SSPRK(10,4) of Ketcheson (2008): ten forward-Euler stages of dt/6 (SSP coefficient 6:
+/// positivity up to six times the forward-Euler step, 0.6 of it per stage against SSPRK3's
+/// 1/3), fourth order, every stage weighted 1/10. Stages 1-5 march from U0; after the fifth,
+/// U1 = 3/5 U0 + 2/5 U1 (= U0 + (2/3) A, A the weighted sum of the rates so far); stages
+/// 6-9 march on; the tenth only adds its rate: U = U0 + A.
+const RATIO: f64 = 6.0;
+/// The stage after which register 1 restarts from U0 (0-based), and A's share in it.
+const RESTART: usize = 4;
+const RESTART_SHARE: f64 = 2.0 / 3.0;
+
+/// A stage: its time in the substep and how far it moves register 1 (fractions of dt), and
+/// its weight in the substep (and in its quadrature of the impulse and the work: fourth
+/// order, so a cubic's integral is exact).
+#[derive(Clone, Copy, Debug)]
+struct Stage {
+    at: f64,
+    ahead: f64,
+    weight: f64,
+}
+
+const fn stage(at: f64, ahead: f64) -> Stage {
+    Stage {
+        at,
+        ahead,
+        weight: 0.1,
+    }
+}
+
+/// Right-hand sides per substep.
+pub const STAGE_COUNT: u64 = STAGES.len() as u64;
+
+const STAGES: [Stage; 10] = [
+    stage(0.0, 1.0 / 6.0),
+    stage(1.0 / 6.0, 1.0 / 6.0),
+    stage(2.0 / 6.0, 1.0 / 6.0),
+    stage(3.0 / 6.0, 1.0 / 6.0),
+    stage(4.0 / 6.0, 1.0 / 6.0),
+    stage(1.0 / 3.0, 1.0 / 6.0),
+    stage(1.0 / 2.0, 1.0 / 6.0),
+    stage(2.0 / 3.0, 1.0 / 6.0),
+    stage(5.0 / 6.0, 1.0 / 6.0),
+    stage(1.0, 0.0),
 ];
 
 /// What a communication step did, per unit breadth and density.
@@ -390,15 +537,17 @@ pub struct Flow {
     pub discharge: Vec<f64>,
 }
 
-/// Stage storage of a substep: the discharges of U0 (its depths are the state's), U1 and U2.
-/// It holds nothing from one call to the next.
+/// Stage storage of a substep: the discharges of U0 (its depths are the state's), register 1
+/// and the next one, and the increment A. It holds nothing from one call to the next.
 #[derive(Debug)]
 pub struct Scratch {
     q0: Vec<f64>,
     h1: Vec<f64>,
     q1: Vec<f64>,
-    h2: Vec<f64>,
-    q2: Vec<f64>,
+    next_h: Vec<f64>,
+    next_q: Vec<f64>,
+    sum_h: Vec<f64>,
+    sum_q: Vec<f64>,
     faces: Faces,
 }
 
@@ -409,8 +558,10 @@ impl Scratch {
             q0: v(),
             h1: v(),
             q1: v(),
-            h2: v(),
-            q2: v(),
+            next_h: v(),
+            next_q: v(),
+            sum_h: v(),
+            sum_q: v(),
             faces: Faces::new(cells),
         }
     }

@@ -133,28 +133,39 @@ struct Side {
 /// the front then runs at u -+ 2c of the wet side. Every case is computed and the right one
 /// selected, without branches, so that a loop of these is vectorised (the unselected ones
 /// may be NaN: the square root of a dry face a few ulps below 0, 0/0 between dry faces).
+///
+/// One division: the speeds are carried times D = sqrt(H_L) + sqrt(H_R) > 0 (the Roe
+/// velocity's denominator), which changes no sign and so no case, and the HLL flux's
+/// denominator becomes D (S_R - S_L).
 #[inline(always)]
 fn hll(l: Side, r: Side, g: f64, root_g: f64, dry: f64) -> (f64, f64, f64) {
     let (wet_l, wet_r) = (l.h >= dry, r.h >= dry);
     // Square roots of the depths: the Roe weights, and times sqrt(g) the celerities.
     let (rl, rr) = (l.h.sqrt(), r.h.sqrt());
     let (cl, cr) = (root_g * rl, root_g * rr);
-    // Roe averages.
-    let u = (rl * l.u + rr * r.u) / (rl + rr);
+    // D times the Roe velocity, and the Roe celerity.
+    let d = rl + rr;
+    let du = rl * l.u + rr * r.u;
     let c = (0.5 * g * (l.h + r.h)).sqrt();
+    // D times the speeds s_L, s_R.
     let (sl, sr) = if !wet_l {
-        (r.u - 2.0 * cr, r.u + cr)
+        (d * (r.u - 2.0 * cr), d * (r.u + cr))
     } else if !wet_r {
-        (l.u - cl, l.u + 2.0 * cl)
+        (d * (l.u - cl), d * (l.u + 2.0 * cl))
     } else {
-        (smaller(l.u - cl, u - c), larger(r.u + cr, u + c))
+        (
+            smaller(d * (l.u - cl), du - d * c),
+            larger(d * (r.u + cr), du + d * c),
+        )
     };
     let flux = |s: Side| (s.h * s.u, s.h * s.u * s.u + 0.5 * g * s.h * s.h);
     let ((fl, ml), (fr, mr)) = (flux(l), flux(r));
-    let inv = 1.0 / (sr - sl);
+    let width = sr - sl;
+    let inv = 1.0 / (d * width);
+    let (dsl, dsr, slr) = (d * sl, d * sr, sl * sr);
     let between = (
-        (sr * fl - sl * fr + sl * sr * (r.h - l.h)) * inv,
-        (sr * ml - sl * mr + sl * sr * (r.h * r.u - l.h * l.u)) * inv,
+        (dsr * fl - dsl * fr + slr * (r.h - l.h)) * inv,
+        (dsr * ml - dsl * mr + slr * (r.h * r.u - l.h * l.u)) * inv,
     );
     let (f, m) = if sl >= 0.0 {
         (fl, ml)
@@ -166,8 +177,114 @@ fn hll(l: Side, r: Side, g: f64, root_g: f64, dry: f64) -> (f64, f64, f64) {
     if !wet_l && !wet_r {
         (0.0, 0.0, 0.0)
     } else {
-        (f, m, larger(sl.abs(), sr.abs()))
+        // max(|s_L|, |s_R|) = max(|S_L|, |S_R|) / D = max(..) (S_R - S_L) / (D (S_R - S_L)).
+        (f, m, larger(sl.abs(), sr.abs()) * width * inv)
     }
+}
+
+/// Width of the chunks the passes over the cells and the interfaces run in: a whole number of
+/// vectors of every build (8 AVX-512F lanes, 2 AVX2 vectors, 4 SSE2 ones).
+const W: usize = 8;
+
+/// The faces of the interior cells 1 + a .. 1 + b for `part` = a..b, from the depths `h` and
+/// velocities `u` of all cells, into `faces` = [ahead_h, ahead_u, behind_h, behind_u] by
+/// interface: cell c's left face is the state ahead of interface c, its right face the state
+/// behind interface c + 1.
+#[inline(always)]
+fn interior_faces(
+    h: &[f64],
+    u: &[f64],
+    rise: f64,
+    faces: [&mut [f64]; 4],
+    part: std::ops::Range<usize>,
+) {
+    let (a, b) = (part.start, part.end);
+    let [ahead_h, ahead_u, behind_h, behind_u] = faces;
+    let cells = ahead_h[1 + a..1 + b]
+        .iter_mut()
+        .zip(&mut ahead_u[1 + a..1 + b])
+        .zip(
+            behind_h[2 + a..2 + b]
+                .iter_mut()
+                .zip(&mut behind_u[2 + a..2 + b]),
+        );
+    let (h, u) = (&h[a..b + 2], &u[a..b + 2]);
+    for ((((lh, lu), (rh, ru)), h), u) in cells.zip(h.windows(3)).zip(u.windows(3)) {
+        (*lh, *lu, *rh, *ru) = faces_of(
+            h[1],
+            u[1],
+            [h[1] - h[0] + rise, h[2] - h[1] + rise],
+            [u[1] - u[0], u[2] - u[1]],
+            rise,
+        );
+    }
+}
+
+/// The HLL fluxes (mass, momentum, largest speed) through the interfaces a..b, each between
+/// the state behind it and the state ahead of it: `sides` = [behind_h, behind_u, ahead_h,
+/// ahead_u] by interface.
+#[inline(always)]
+fn fluxes(
+    sides: [&[f64]; 4],
+    out: [&mut [f64]; 3],
+    g: f64,
+    dry: f64,
+    part: std::ops::Range<usize>,
+) {
+    let (a, b) = (part.start, part.end);
+    let [behind_h, behind_u, ahead_h, ahead_u] = sides;
+    let [mass, momentum, speed] = out;
+    let root_g = g.sqrt();
+    let out = mass[a..b]
+        .iter_mut()
+        .zip(&mut momentum[a..b])
+        .zip(&mut speed[a..b]);
+    let behind = behind_h[a..b].iter().zip(&behind_u[a..b]);
+    let ahead = ahead_h[a..b].iter().zip(&ahead_u[a..b]);
+    for (((f, m), s), ((&hl, &ul), (&hr, &ur))) in out.zip(behind.zip(ahead)) {
+        (*f, *m, *s) = hll(Side { h: hl, u: ul }, Side { h: hr, u: ur }, g, root_g, dry);
+    }
+}
+
+/// 0..len as one range of a whole number of chunks of W and, if len is not a multiple of W,
+/// the last W elements again (overlapping the first range, whose elements there it computes
+/// again from the same inputs, to the same bits); below W elements, 0..len. A loop over each
+/// then runs whole vectors only, no scalar remainder (at 200 cells, the remainders of the
+/// face and flux passes cost about as much as three chunks of eight).
+fn whole_chunks(len: usize) -> impl Iterator<Item = std::ops::Range<usize>> {
+    let rest = len % W;
+    // Below W elements, or a whole number of chunks: one range.
+    let (first, tail) = if len < W || rest == 0 {
+        (0..len, None)
+    } else {
+        (0..len - rest, Some(len - W..len))
+    };
+    std::iter::once(first).chain(tail)
+}
+
+/// The sum of `x` in eight lanes, element i into lane i mod 8, the lanes then added pairwise
+/// in a fixed order: the same operations on every build, so the same bits, and no chain of
+/// dependent additions as long as `x` (which a sum in order is, at 3-4 cycles an addition).
+#[inline(always)]
+pub fn lane_sum(x: &[f64]) -> f64 {
+    lane_sum_by(x.len(), |i| x[i])
+}
+
+/// The sum of `term(i)` for i in 0..n, in eight lanes as [`lane_sum`].
+#[inline(always)]
+pub fn lane_sum_by(n: usize, term: impl Fn(usize) -> f64) -> f64 {
+    let mut lanes = [0.0; 8];
+    let whole = n - n % 8;
+    for k in (0..whole).step_by(8) {
+        for (j, l) in lanes.iter_mut().enumerate() {
+            *l += term(k + j);
+        }
+    }
+    for (j, l) in lanes.iter_mut().enumerate().take(n - whole) {
+        *l += term(whole + j);
+    }
+    let [a, b, c, d, e, f, g, h] = lanes;
+    ((a + e) + (c + g)) + ((b + f) + (d + h))
 }
 
 /// What a pass of the right-hand side gives besides the cell rates.
@@ -180,6 +297,22 @@ pub struct Sweep {
     pub mass_flux: f64,
     /// Largest wave speed |s| of any interface [m/s].
     pub speed: f64,
+}
+
+/// Where a stage's rates go instead of [`Faces::rates`]: register 1 moves ahead, U' = U +
+/// ahead L(U), and the stage's share of the substep's increment is summed, A = weight L(U)
+/// (the first stage) or A += weight L(U). Fused into the pass that forms the rates, so that
+/// the stage's update runs in the same vectorised build.
+#[derive(Debug)]
+pub struct March<'a> {
+    /// dt times how far the stage moves register 1, and dt times its weight.
+    pub ahead: f64,
+    pub weight: f64,
+    /// Whether A starts here (the first stage of a substep).
+    pub first: bool,
+    /// U' (depths, discharges), written; A, written (first) or added to.
+    pub next: [&'a mut [f64]; 2],
+    pub sum: [&'a mut [f64]; 2],
 }
 
 /// The faces of a cell of depth `depth` and velocity `u` from the differences of the surface
@@ -200,18 +333,19 @@ fn faces_of(depth: f64, u: f64, dw: [f64; 2], du: [f64; 2], rise: f64) -> (f64, 
     )
 }
 
-/// Storage of [`sweep`]: per cell its velocity, the depths and velocities of its two faces and
-/// its rates, per interface (cells + 1, the walls included) the mass and momentum fluxes and
-/// the largest wave speed.
+/// Storage of [`sweep`]: per cell its velocity and its rates, per interface (cells + 1, the
+/// walls included) the depths and velocities behind and ahead of it (the faces of the cells
+/// either side; at a wall, the mirror of the wall cell's face), the mass and momentum fluxes
+/// and the largest wave speed.
 #[derive(Debug)]
 pub struct Faces {
     depth_rate: Vec<f64>,
     discharge_rate: Vec<f64>,
     u: Vec<f64>,
-    left_h: Vec<f64>,
-    left_u: Vec<f64>,
-    right_h: Vec<f64>,
-    right_u: Vec<f64>,
+    behind_h: Vec<f64>,
+    behind_u: Vec<f64>,
+    ahead_h: Vec<f64>,
+    ahead_u: Vec<f64>,
     mass: Vec<f64>,
     momentum: Vec<f64>,
     speed: Vec<f64>,
@@ -224,10 +358,10 @@ impl Faces {
             depth_rate: v(cells),
             discharge_rate: v(cells),
             u: v(cells),
-            left_h: v(cells),
-            left_u: v(cells),
-            right_h: v(cells),
-            right_u: v(cells),
+            behind_h: v(cells + 1),
+            behind_u: v(cells + 1),
+            ahead_h: v(cells + 1),
+            ahead_u: v(cells + 1),
             mass: v(cells + 1),
             momentum: v(cells + 1),
             speed: v(cells + 1),
@@ -263,65 +397,111 @@ pub fn sweep(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sw
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
             // SAFETY: sweep_avx512 only needs AVX-512F, which this CPU has (just checked).
-            return unsafe { sweep_avx512(grid, h, q, a, faces) };
+            return unsafe { sweep_avx512(grid, h, q, a, faces, None) };
         }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: sweep_avx2 only needs AVX2, which this CPU has (just checked).
-            return unsafe { sweep_avx2(grid, h, q, a, faces) };
+            return unsafe { sweep_avx2(grid, h, q, a, faces, None) };
         }
     }
-    sweep_passes(grid, h, q, a, faces)
+    sweep_passes(grid, h, q, a, faces, None)
 }
 
 /// Every build of [`sweep_passes`] this CPU can run, by name, each given to `check` with what
-/// it left in `faces` (the tests compare them).
+/// it left in `faces` and, run again with a [`March`] (`first` or not; A starting from
+/// `start` when not), the stage's next register 1 and A (the tests compare them).
 #[cfg(test)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn each_build(
     grid: &Grid,
     h: &[f64],
     q: &[f64],
     a: f64,
     faces: &mut Faces,
-    mut check: impl FnMut(&str, Sweep, &Faces),
+    first: bool,
+    start: &[f64],
+    mut check: impl FnMut(&str, Sweep, &Faces, [&[f64]; 4]),
 ) {
-    let s = sweep_passes(grid, h, q, a, faces);
-    check("baseline", s, faces);
+    type Build = fn(&Grid, &[f64], &[f64], f64, &mut Faces, Option<&mut March>) -> Sweep;
+    let mut builds: Vec<(&str, Build)> = vec![("baseline", |g, h, q, a, f, m| {
+        sweep_passes(g, h, q, a, f, m)
+    })];
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: this CPU has AVX2 (just checked).
-            let s = unsafe { sweep_avx2(grid, h, q, a, faces) };
-            check("avx2", s, faces);
+            // SAFETY: only run on this CPU, which has AVX2 (just checked).
+            builds.push(("avx2", |g, h, q, a, f, m| unsafe {
+                sweep_avx2(g, h, q, a, f, m)
+            }));
         }
         if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: this CPU has AVX-512F (just checked).
-            let s = unsafe { sweep_avx512(grid, h, q, a, faces) };
-            check("avx512f", s, faces);
+            // SAFETY: only run on this CPU, which has AVX-512F (just checked).
+            builds.push(("avx512f", |g, h, q, a, f, m| unsafe {
+                sweep_avx512(g, h, q, a, f, m)
+            }));
         }
+    }
+    let n = grid.cells;
+    for (name, build) in builds {
+        let s = build(grid, h, q, a, faces, None);
+        let (mut next_h, mut next_q) = (vec![0.0; n], vec![0.0; n]);
+        let (mut sum_h, mut sum_q) = (start.to_vec(), start.to_vec());
+        let mut march = March {
+            ahead: 1e-3,
+            weight: 3e-4,
+            first,
+            next: [&mut next_h, &mut next_q],
+            sum: [&mut sum_h, &mut sum_q],
+        };
+        let s_march = build(grid, h, q, a, &mut Faces::new(n), Some(&mut march));
+        assert_eq!(s, s_march, "{name}: the march changes the sweep");
+        check(name, s, faces, [&next_h, &next_q, &sum_h, &sum_q]);
     }
 }
 
 /// [`sweep_passes`] compiled for AVX-512F.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn sweep_avx512(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
-    sweep_passes(grid, h, q, a, faces)
+fn sweep_avx512(
+    grid: &Grid,
+    h: &[f64],
+    q: &[f64],
+    a: f64,
+    faces: &mut Faces,
+    march: Option<&mut March>,
+) -> Sweep {
+    sweep_passes(grid, h, q, a, faces, march)
 }
 
 /// [`sweep_passes`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn sweep_avx2(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
-    sweep_passes(grid, h, q, a, faces)
+fn sweep_avx2(
+    grid: &Grid,
+    h: &[f64],
+    q: &[f64],
+    a: f64,
+    faces: &mut Faces,
+    march: Option<&mut March>,
+) -> Sweep {
+    sweep_passes(grid, h, q, a, faces, march)
 }
 
-/// The passes of [`sweep`], for any CPU (the baseline build).
+/// The passes of [`sweep`], for any CPU (the baseline build); the rates go to `march` if
+/// given (then [`Faces::rates`] is not written). Inlined into the builds of a whole
+/// communication step ([`super::Channel::advance_in`]) too.
 #[inline(always)]
-fn sweep_passes(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
+pub(super) fn sweep_passes(
+    grid: &Grid,
+    h: &[f64],
+    q: &[f64],
+    a: f64,
+    faces: &mut Faces,
+    march: Option<&mut March>,
+) -> Sweep {
     let n = grid.cells;
     let (h, q) = (&h[..n], &q[..n]);
     let (g, dry, dx) = (grid.g_e, grid.dry, grid.dx);
-    let root_g = g.sqrt();
     let inv_dx = 1.0 / dx;
     // Rise of the pseudo-bottom z = a x / g_e from one cell centre to the next.
     let rise = a * dx / g;
@@ -330,16 +510,17 @@ fn sweep_passes(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) ->
         depth_rate,
         discharge_rate,
         u,
-        left_h,
-        left_u,
-        right_h,
-        right_u,
+        behind_h,
+        behind_u,
+        ahead_h,
+        ahead_u,
         mass,
         momentum,
         speed,
     } = faces;
-    let (u, left_h, left_u) = (&mut u[..n], &mut left_h[..n], &mut left_u[..n]);
-    let (right_h, right_u) = (&mut right_h[..n], &mut right_u[..n]);
+    let u = &mut u[..n];
+    let (behind_h, behind_u) = (&mut behind_h[..=n], &mut behind_u[..=n]);
+    let (ahead_h, ahead_u) = (&mut ahead_h[..=n], &mut ahead_u[..=n]);
     let (mass, momentum, speed) = (&mut mass[..=n], &mut momentum[..=n], &mut speed[..=n]);
     for ((u, &h), &q) in u.iter_mut().zip(h).zip(q) {
         *u = velocity(q, h, dry);
@@ -347,54 +528,47 @@ fn sweep_passes(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) ->
     let u = &*u;
     // Cell i's faces from the differences of the surface w = H + z and of u across its left
     // and right interfaces (at the walls those with the mirror cell: 0 for w, +-2u for u).
-    let mut put = |i: usize, dw: [f64; 2], du: [f64; 2]| {
-        (left_h[i], left_u[i], right_h[i], right_u[i]) = faces_of(h[i], u[i], dw, du, rise);
-    };
     let last = n - 1;
-    if n > 1 {
-        put(0, [0.0, h[1] - h[0] + rise], [2.0 * u[0], u[1] - u[0]]);
-        put(
-            last,
-            [h[last] - h[last - 1] + rise, 0.0],
-            [u[last] - u[last - 1], -2.0 * u[last]],
-        );
+    let edges = if n > 1 {
+        [
+            (0, [0.0, h[1] - h[0] + rise], [2.0 * u[0], u[1] - u[0]]),
+            (
+                last,
+                [h[last] - h[last - 1] + rise, 0.0],
+                [u[last] - u[last - 1], -2.0 * u[last]],
+            ),
+        ]
     } else {
-        put(0, [0.0, 0.0], [2.0 * u[0], -2.0 * u[0]]);
+        [(0, [0.0, 0.0], [2.0 * u[0], -2.0 * u[0]]); 2]
+    };
+    for (i, dw, du) in edges {
+        (ahead_h[i], ahead_u[i], behind_h[i + 1], behind_u[i + 1]) =
+            faces_of(h[i], u[i], dw, du, rise);
     }
-    let cells = left_h[1..]
-        .iter_mut()
-        .zip(&mut left_u[1..])
-        .zip(right_h[1..].iter_mut().zip(&mut right_u[1..]));
-    for ((((lh, lu), (rh, ru)), h), u) in cells.zip(h.windows(3)).zip(u.windows(3)) {
-        (*lh, *lu, *rh, *ru) = faces_of(
-            h[1],
-            u[1],
-            [h[1] - h[0] + rise, h[2] - h[1] + rise],
-            [u[1] - u[0], u[2] - u[1]],
-            rise,
+    for part in whole_chunks(n.saturating_sub(2)) {
+        let faces = [&mut *ahead_h, &mut *ahead_u, &mut *behind_h, &mut *behind_u];
+        interior_faces(h, u, rise, faces, part);
+    }
+    // The walls: behind the left one and ahead of the right one, the mirror of the wall
+    // cell's face (the depth the same, the velocity reversed).
+    (behind_h[0], behind_u[0]) = (ahead_h[0], -ahead_u[0]);
+    (ahead_h[n], ahead_u[n]) = (behind_h[n], -behind_u[n]);
+    for part in whole_chunks(n + 1) {
+        let sides = [&*behind_h, &*behind_u, &*ahead_h, &*ahead_u];
+        fluxes(
+            sides,
+            [&mut *mass, &mut *momentum, &mut *speed],
+            g,
+            dry,
+            part,
         );
     }
-    // The interior interfaces: the right face of cell j - 1 against the left face of cell j.
-    let interior = mass[1..n]
-        .iter_mut()
-        .zip(&mut momentum[1..n])
-        .zip(&mut speed[1..n]);
-    let behind = right_h.iter().zip(right_u.iter());
-    let ahead = left_h[1..].iter().zip(&left_u[1..]);
-    for (((f, m), s), ((&hl, &ul), (&hr, &ur))) in interior.zip(behind.zip(ahead)) {
-        (*f, *m, *s) = hll(Side { h: hl, u: ul }, Side { h: hr, u: ur }, g, root_g, dry);
-    }
-    // The walls: mirror states; no mass flux by symmetry.
-    let mirror = |h: f64, u: f64| (Side { h, u: -u }, Side { h, u });
-    let (ghost, face) = mirror(left_h[0], left_u[0]);
-    let (_, m, s) = hll(ghost, face, g, root_g, dry);
-    (mass[0], momentum[0], speed[0]) = (0.0, m, s);
-    let (ghost, face) = mirror(right_h[last], right_u[last]);
-    let (_, m, s) = hll(face, ghost, g, root_g, dry);
-    (mass[n], momentum[n], speed[n]) = (0.0, m, s);
-    // The largest speed, in 4 lanes (the maximum does not depend on the order).
-    let mut lanes = [0.0; 4];
-    let mut chunks = speed.chunks_exact(4);
+    // No mass flux through the walls (by symmetry; the formula leaves rounding there).
+    (mass[0], mass[n]) = (0.0, 0.0);
+    // The largest speed, in 16 lanes (the maximum does not depend on the order; 16: two
+    // independent chains of 8-lane maxima, not one of 4-lane ones twice as long).
+    let mut lanes = [0.0; 16];
+    let mut chunks = speed.chunks_exact(16);
     for c in &mut chunks {
         for (l, &s) in lanes.iter_mut().zip(c) {
             *l = faster(*l, s);
@@ -405,15 +579,53 @@ fn sweep_passes(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) ->
     }
     let out = Sweep {
         wall: [momentum[0], momentum[n]],
-        // In order, as a sum must be to be the same on every build.
-        mass_flux: mass[1..n].iter().fold(0.0, |sum, f| sum + f),
+        mass_flux: lane_sum(&mass[1..n]),
         speed: lanes.into_iter().fold(0.0, faster),
     };
-    let rates = depth_rate[..n].iter_mut().zip(&mut discharge_rate[..n]);
-    for (((dh, dq), &h), (f, m)) in rates.zip(h).zip(mass.windows(2).zip(momentum.windows(2))) {
-        *dh = -(f[1] - f[0]) * inv_dx;
-        // The inertial force on the cell's liquid: -a_b H_i (the cell average).
-        *dq = -(m[1] - m[0]) * inv_dx - a * h;
+    // The rates; the inertial force on a cell's liquid is -a_b H_i (the cell average).
+    let fluxes = mass.windows(2).zip(momentum.windows(2));
+    match march {
+        None => {
+            let rates = depth_rate[..n].iter_mut().zip(&mut discharge_rate[..n]);
+            for (((dh, dq), &h), (f, m)) in rates.zip(h).zip(fluxes) {
+                *dh = -(f[1] - f[0]) * inv_dx;
+                *dq = -(m[1] - m[0]) * inv_dx - a * h;
+            }
+        }
+        Some(March {
+            ahead,
+            weight,
+            first,
+            next: [next_h, next_q],
+            sum: [sum_h, sum_q],
+        }) => {
+            let (ahead, weight) = (*ahead, *weight);
+            let (next_h, next_q) = (&mut next_h[..n], &mut next_q[..n]);
+            let (sum_h, sum_q) = (&mut sum_h[..n], &mut sum_q[..n]);
+            let next = next_h.iter_mut().zip(next_q.iter_mut());
+            let sums = sum_h.iter_mut().zip(sum_q.iter_mut());
+            let cells = next.zip(sums).zip(h.iter().zip(q)).zip(fluxes);
+            // Two loops, not a branch per cell: A written or added to.
+            if *first {
+                for ((((nh, nq), (sh, sq)), (&h, &q)), (f, m)) in cells {
+                    let dh = -(f[1] - f[0]) * inv_dx;
+                    let dq = -(m[1] - m[0]) * inv_dx - a * h;
+                    *nh = h + ahead * dh;
+                    *nq = q + ahead * dq;
+                    *sh = weight * dh;
+                    *sq = weight * dq;
+                }
+            } else {
+                for ((((nh, nq), (sh, sq)), (&h, &q)), (f, m)) in cells {
+                    let dh = -(f[1] - f[0]) * inv_dx;
+                    let dq = -(m[1] - m[0]) * inv_dx - a * h;
+                    *nh = h + ahead * dh;
+                    *nq = q + ahead * dq;
+                    *sh += weight * dh;
+                    *sq += weight * dq;
+                }
+            }
+        }
     }
     out
 }

@@ -212,10 +212,13 @@ fn vectorised_passes_are_bit_for_bit_the_baseline() {
             &f.discharge,
             a,
             &mut faces,
-            |name, s, faces| {
+            k % 2 == 0,
+            &f.discharge,
+            |name, s, faces, march| {
                 let (dh, dq) = faces.rates();
                 let all = dh.iter().chain(dq).chain(faces.mass_fluxes());
                 let all = all.chain(&s.wall).chain([&s.mass_flux, &s.speed]);
+                let all = all.chain(march.into_iter().flatten());
                 results.push((
                     name.to_string(),
                     all.map(|x| x.to_bits()).collect::<Vec<_>>(),
@@ -231,33 +234,68 @@ fn vectorised_passes_are_bit_for_bit_the_baseline() {
     assert!(dry > 0, "the run must dry cells");
 }
 
+/// The whole communication step (stages, updates, drag, films), compiled for each instruction
+/// set, gives the same bits from every build: at each state of a violent run with dry cells,
+/// a 10 ms step with input derivatives from there.
+#[test]
+fn vectorised_steps_are_bit_for_bit_the_baseline() {
+    let ch = lab(40);
+    let w = omega_1(&ch);
+    let run = violent(40, 300, 0.01, 0.1);
+    let mut builds = vec![];
+    for (k, (f, _, _)) in run.iter().enumerate().step_by(7) {
+        let base = harmonic(0.1, w, k as f64 * 0.01);
+        let results = ch.each_build(f, 0.01, &base, 0.3);
+        let bits = |(_, r, g): &(&str, Result<Advanced, SolveError>, Flow)| {
+            let d = r.as_ref().expect("step");
+            let all = g
+                .depth
+                .iter()
+                .chain(&g.discharge)
+                .chain([&d.impulse, &d.work]);
+            (all.map(|x| x.to_bits()).collect::<Vec<_>>(), d.substeps)
+        };
+        let first = bits(&results[0]);
+        for r in &results[1..] {
+            assert_eq!(bits(r), first, "step {k}: {} against the baseline", r.0);
+        }
+        builds = results.iter().map(|r| r.0).collect();
+    }
+    eprintln!("builds compared: {builds:?}");
+}
+
 /// Energy: dissipated = input - stored never decreases, step by step, through bores and
-/// drying (the scheme is entropy stable in practice; the drag and the bores only take).
+/// drying (the scheme is entropy stable in practice; the drag and the bores only take), from
+/// a coarse grid to the default's. (Under SSPRK3, whose quadrature of the work was exact only
+/// to cubics by the luck of Simpson's rule, the first step from rest created energy at 20
+/// cells; SSPRK(10,4)'s is fourth order.)
 #[test]
 fn dissipation_never_decreases() {
-    let ch = lab(40);
-    let run = violent(40, 1000, 0.01, 0.1);
-    let (mut input, mut last) = (0.0, 0.0);
-    let mut least: f64 = f64::INFINITY;
-    for (f, d, _) in &run {
-        input += d.work;
-        let dissipated = input - ch.energy(f);
-        if dissipated - last < 0.0 {
-            eprintln!(
-                "decrease {:e} work {:e} E {:e} sub {} rej {}",
-                dissipated - last,
-                d.work,
-                ch.energy(f),
-                d.substeps,
-                d.rejected
-            );
+    for cells in [20, 40, 200] {
+        let ch = lab(cells);
+        let run = violent(cells, 1000, 0.01, 0.1);
+        let (mut input, mut last) = (0.0, 0.0);
+        let mut least: f64 = f64::INFINITY;
+        for (k, (f, d, _)) in run.iter().enumerate() {
+            input += d.work;
+            let dissipated = input - ch.energy(f);
+            if dissipated - last < 0.0 {
+                eprintln!(
+                    "{cells} cells, step {k}: decrease {:e}, work {:e}, stored {:e}",
+                    dissipated - last,
+                    d.work,
+                    ch.energy(f),
+                );
+            }
+            least = least.min(dissipated - last);
+            last = dissipated;
         }
-        least = least.min(dissipated - last);
-        last = dissipated;
+        eprintln!(
+            "{cells} cells: dissipated {last:e}, input {input:e}, smallest increment {least:e}"
+        );
+        assert!(least >= 0.0, "{cells} cells: {least:e}");
+        assert!(last > 0.1 * input);
     }
-    eprintln!("energy: dissipated {last:e}, input {input:e}, smallest increment {least:e}");
-    assert!(least >= 0.0, "{least:e}");
-    assert!(last > 0.1 * input);
 }
 
 /// The still lab tank with its surface raised by `amp` cos(k pi x/a), as exact cell
@@ -511,10 +549,10 @@ fn bore_speed_and_loss_follow_rankine_hugoniot() {
 fn absurd_steps_are_refused() {
     let ch = lab(40);
     let mut f = mode(&ch, 1.0, 0.1 * ch.depth);
-    // About 5 substeps per 10 ms here: a 1 s step needs about 500.
-    let r = ch.advance(&mut f.clone(), 1.0, &held(0.0), 0.0, 100);
+    // A substep of 2.7 dx over the fastest wave is about 33 ms here: a 1 s step needs 30.
+    let r = ch.advance(&mut f.clone(), 1.0, &held(0.0), 0.0, 10);
     assert!(
-        matches!(r, Err(SolveError::TooManySteps { limit: 100, .. })),
+        matches!(r, Err(SolveError::TooManySteps { limit: 10, .. })),
         "{r:?}"
     );
     let r = ch.advance(&mut f, 0.01, &held(f64::MAX), 0.0, 1_000_000);
