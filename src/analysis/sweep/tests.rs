@@ -410,6 +410,12 @@ fn shallow_water_hardens_and_dissipates_as_the_mechanical_models() {
         nonlinear(0.003)
     );
     let hardening = (k_large - 1.0) / (nonlinear(0.03) - 1.0);
+    eprintln!(
+        "shallow water: kappa {k_small} (Nonlinear {}), {k_large} (Nonlinear {}); zeta {z_small}, \
+         {z_large}",
+        nonlinear(0.003),
+        nonlinear(0.03)
+    );
     assert!(
         (0.75..1.33).contains(&hardening),
         "{k_large} vs {}",

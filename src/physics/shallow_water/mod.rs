@@ -15,6 +15,68 @@
 //! into equal substeps n = ceil(remaining / dt_cfl), recomputed after every substep (the speeds
 //! change), so that the last one lands exactly on the communication point.
 
+/// One function compiled for several instruction sets: `$passes` (`#[inline(always)]`, any
+/// CPU: the baseline build) inlined into `$avx512` and `$avx2`, compiled with those target
+/// features, and `$dispatch`, which runs the widest this CPU has (`is_x86_feature_detected`
+/// caches its answer). `$builds` (tests only) lists the builds this CPU can run, by name. The
+/// same operations in the same order in every build, no fused multiply-adds (the compiler
+/// contracts none unasked): the same bits, which the tests check.
+macro_rules! builds {
+    (
+        $(#[$meta:meta])*
+        $vis:vis fn $dispatch:ident, $avx512:ident, $avx2:ident, $builds:ident = $passes:ident
+        ($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty;
+    ) => {
+        $(#[$meta])*
+        $vis fn $dispatch($($arg: $ty),*) -> $ret {
+            #[cfg(target_arch = "x86_64")]
+            {
+                if std::arch::is_x86_feature_detected!("avx512f") {
+                    // SAFETY: only AVX-512F is needed, and this CPU has it (just checked).
+                    return unsafe { $avx512($($arg),*) };
+                }
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: only AVX2 is needed, and this CPU has it (just checked).
+                    return unsafe { $avx2($($arg),*) };
+                }
+            }
+            $passes($($arg),*)
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx512f")]
+        fn $avx512($($arg: $ty),*) -> $ret {
+            $passes($($arg),*)
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        fn $avx2($($arg: $ty),*) -> $ret {
+            $passes($($arg),*)
+        }
+
+        /// The builds of this function the CPU can run, by name (the tests compare them).
+        #[cfg(test)]
+        #[allow(clippy::type_complexity)]
+        pub(super) fn $builds() -> Vec<(&'static str, fn($($ty),*) -> $ret)> {
+            let mut builds: Vec<(&'static str, fn($($ty),*) -> $ret)> =
+                vec![("baseline", |$($arg),*| $passes($($arg),*))];
+            #[cfg(target_arch = "x86_64")]
+            {
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: returned to run on this CPU only, which has AVX2 (just checked).
+                    builds.push(("avx2", |$($arg),*| unsafe { $avx2($($arg),*) }));
+                }
+                if std::arch::is_x86_feature_detected!("avx512f") {
+                    // SAFETY: returned to run on this CPU only, which has AVX-512F.
+                    builds.push(("avx512f", |$($arg),*| unsafe { $avx512($($arg),*) }));
+                }
+            }
+            builds
+        }
+    };
+}
+
 #[cfg(test)]
 mod exact;
 pub mod scheme;
@@ -174,18 +236,7 @@ impl Channel {
         c: f64,
         most: u64,
     ) -> Result<Advanced, SolveError> {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                // SAFETY: advance_avx512 only needs AVX-512F, which this CPU has (just checked).
-                return unsafe { self.advance_avx512(w, f, h, base, c, most) };
-            }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: advance_avx2 only needs AVX2, which this CPU has (just checked).
-                return unsafe { self.advance_avx2(w, f, h, base, c, most) };
-            }
-        }
-        self.advance_passes(w, f, h, base, c, most)
+        advance(self, w, f, h, base, c, most)
     }
 
     /// Every build of [`Channel::advance_in`] this CPU can run, by name, each on a copy of
@@ -199,118 +250,14 @@ impl Channel {
         c: f64,
     ) -> Vec<(&'static str, Result<Advanced, SolveError>, Flow)> {
         let mut w = Scratch::new(self.cells);
-        let mut out = vec![];
-        let mut g = f.clone();
-        out.push((
-            "baseline",
-            self.advance_passes(&mut w, &mut g, h, base, c, u64::MAX),
-            g,
-        ));
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") {
+        advance_builds()
+            .into_iter()
+            .map(|(name, build)| {
                 let mut g = f.clone();
-                // SAFETY: this CPU has AVX2 (just checked).
-                let r = unsafe { self.advance_avx2(&mut w, &mut g, h, base, c, u64::MAX) };
-                out.push(("avx2", r, g));
-            }
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                let mut g = f.clone();
-                // SAFETY: this CPU has AVX-512F (just checked).
-                let r = unsafe { self.advance_avx512(&mut w, &mut g, h, base, c, u64::MAX) };
-                out.push(("avx512f", r, g));
-            }
-        }
-        out
-    }
-
-    /// [`Channel::advance_passes`] compiled for AVX-512F.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    fn advance_avx512(
-        &self,
-        w: &mut Scratch,
-        f: &mut Flow,
-        h: f64,
-        base: &BaseAcceleration,
-        c: f64,
-        most: u64,
-    ) -> Result<Advanced, SolveError> {
-        self.advance_passes(w, f, h, base, c, most)
-    }
-
-    /// [`Channel::advance_passes`] compiled for AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn advance_avx2(
-        &self,
-        w: &mut Scratch,
-        f: &mut Flow,
-        h: f64,
-        base: &BaseAcceleration,
-        c: f64,
-        most: u64,
-    ) -> Result<Advanced, SolveError> {
-        self.advance_passes(w, f, h, base, c, most)
-    }
-
-    /// The substeps of [`Channel::advance_in`], for any CPU (the baseline build): compiled
-    /// whole, the scheme's passes included, for each instruction set the CPU may have, and
-    /// the widest chosen once per communication step (the same operations in the same order
-    /// in every build, no fused multiply-adds: the same bits, tested).
-    #[inline(always)]
-    fn advance_passes(
-        &self,
-        w: &mut Scratch,
-        f: &mut Flow,
-        h: f64,
-        base: &BaseAcceleration,
-        c: f64,
-        most: u64,
-    ) -> Result<Advanced, SolveError> {
-        let grid = self.grid();
-        let dx = grid.dx;
-        let mut done = Advanced::default();
-        let mut t = 0.0;
-        // The largest face speed met so far in this step: the next substep's CFL speed.
-        let mut speed = self.cell_speed(f);
-        while t < h {
-            let remaining = h - t;
-            let dt_cfl = if speed > 0.0 {
-                CFL * dx / speed
-            } else {
-                f64::INFINITY
-            };
-            let substeps = (remaining / dt_cfl).ceil().max(1.0);
-            if done.substeps as f64 + substeps > most as f64 {
-                return Err(SolveError::TooManySteps { limit: most, t });
-            }
-            let last = substeps <= 1.0;
-            let dt = if last {
-                remaining
-            } else {
-                remaining / substeps
-            };
-            match self.substep(f, w, t, dt, base, c) {
-                Ok(sub) => {
-                    done.impulse += sub.impulse;
-                    done.work += sub.work;
-                    done.substeps += 1;
-                    speed = sub.speed;
-                    t = if last { h } else { t + dt };
-                    if !sub.finite {
-                        return Err(SolveError::NonFinite { t });
-                    }
-                }
-                // A wave faster than the step allows: take it again at the CFL step of that
-                // speed (the state is untouched until a substep is accepted).
-                Err(faster) => {
-                    done.rejected += 1;
-                    speed = faster;
-                }
-            }
-        }
-        Ok(done)
+                let r = build(self, &mut w, &mut g, h, base, c, u64::MAX);
+                (name, r, g)
+            })
+            .collect()
     }
 
     /// Largest |u| + sqrt(g_e H) of the cell averages.
@@ -458,6 +405,77 @@ impl Channel {
             finite,
         })
     }
+}
+
+/// The substeps of [`Channel::advance_in`], for any CPU (the baseline build): compiled
+/// whole, the scheme's passes included, for each instruction set the CPU may have
+/// ([`advance`]), the widest chosen once per communication step.
+#[inline(always)]
+fn advance_passes(
+    ch: &Channel,
+    w: &mut Scratch,
+    f: &mut Flow,
+    h: f64,
+    base: &BaseAcceleration,
+    c: f64,
+    most: u64,
+) -> Result<Advanced, SolveError> {
+    let grid = ch.grid();
+    let dx = grid.dx;
+    let mut done = Advanced::default();
+    let mut t = 0.0;
+    // The largest face speed met so far in this step: the next substep's CFL speed.
+    let mut speed = ch.cell_speed(f);
+    while t < h {
+        let remaining = h - t;
+        let dt_cfl = if speed > 0.0 {
+            CFL * dx / speed
+        } else {
+            f64::INFINITY
+        };
+        let substeps = (remaining / dt_cfl).ceil().max(1.0);
+        if done.substeps as f64 + substeps > most as f64 {
+            return Err(SolveError::TooManySteps { limit: most, t });
+        }
+        let last = substeps <= 1.0;
+        let dt = if last {
+            remaining
+        } else {
+            remaining / substeps
+        };
+        match ch.substep(f, w, t, dt, base, c) {
+            Ok(sub) => {
+                done.impulse += sub.impulse;
+                done.work += sub.work;
+                done.substeps += 1;
+                speed = sub.speed;
+                t = if last { h } else { t + dt };
+                if !sub.finite {
+                    return Err(SolveError::NonFinite { t });
+                }
+            }
+            // A wave faster than the step allows: take it again at the CFL step of that
+            // speed (the state is untouched until a substep is accepted).
+            Err(faster) => {
+                done.rejected += 1;
+                speed = faster;
+            }
+        }
+    }
+    Ok(done)
+}
+
+builds! {
+    /// [`Channel::advance_in`]: every substep of a communication step in the widest build.
+    fn advance, advance_avx512, advance_avx2, advance_builds = advance_passes(
+        ch: &Channel,
+        w: &mut Scratch,
+        f: &mut Flow,
+        h: f64,
+        base: &BaseAcceleration,
+        c: f64,
+        most: u64,
+    ) -> Result<Advanced, SolveError>;
 }
 
 /// SSPRK(10,4) of Ketcheson (2008): ten forward-Euler stages of dt/6 (SSP coefficient 6:

@@ -393,18 +393,19 @@ impl Faces {
 /// operations on the same numbers in the same order (no fused multiply-adds, nothing
 /// reassociated): the results are bit for bit those of the baseline build (tested).
 pub fn sweep(grid: &Grid, h: &[f64], q: &[f64], a: f64, faces: &mut Faces) -> Sweep {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: sweep_avx512 only needs AVX-512F, which this CPU has (just checked).
-            return unsafe { sweep_avx512(grid, h, q, a, faces, None) };
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: sweep_avx2 only needs AVX2, which this CPU has (just checked).
-            return unsafe { sweep_avx2(grid, h, q, a, faces, None) };
-        }
-    }
-    sweep_passes(grid, h, q, a, faces, None)
+    sweep_widest(grid, h, q, a, faces, None)
+}
+
+builds! {
+    /// [`sweep_passes`] in the widest build this CPU runs.
+    fn sweep_widest, sweep_avx512, sweep_avx2, sweep_builds = sweep_passes(
+        grid: &Grid,
+        h: &[f64],
+        q: &[f64],
+        a: f64,
+        faces: &mut Faces,
+        march: Option<&mut March>,
+    ) -> Sweep;
 }
 
 /// Every build of [`sweep_passes`] this CPU can run, by name, each given to `check` with what
@@ -422,25 +423,7 @@ pub(super) fn each_build(
     start: &[f64],
     mut check: impl FnMut(&str, Sweep, &Faces, [&[f64]; 4]),
 ) {
-    type Build = fn(&Grid, &[f64], &[f64], f64, &mut Faces, Option<&mut March>) -> Sweep;
-    let mut builds: Vec<(&str, Build)> = vec![("baseline", |g, h, q, a, f, m| {
-        sweep_passes(g, h, q, a, f, m)
-    })];
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: only run on this CPU, which has AVX2 (just checked).
-            builds.push(("avx2", |g, h, q, a, f, m| unsafe {
-                sweep_avx2(g, h, q, a, f, m)
-            }));
-        }
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: only run on this CPU, which has AVX-512F (just checked).
-            builds.push(("avx512f", |g, h, q, a, f, m| unsafe {
-                sweep_avx512(g, h, q, a, f, m)
-            }));
-        }
-    }
+    let builds = sweep_builds();
     let n = grid.cells;
     for (name, build) in builds {
         let s = build(grid, h, q, a, faces, None);
@@ -457,34 +440,6 @@ pub(super) fn each_build(
         assert_eq!(s, s_march, "{name}: the march changes the sweep");
         check(name, s, faces, [&next_h, &next_q, &sum_h, &sum_q]);
     }
-}
-
-/// [`sweep_passes`] compiled for AVX-512F.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-fn sweep_avx512(
-    grid: &Grid,
-    h: &[f64],
-    q: &[f64],
-    a: f64,
-    faces: &mut Faces,
-    march: Option<&mut March>,
-) -> Sweep {
-    sweep_passes(grid, h, q, a, faces, march)
-}
-
-/// [`sweep_passes`] compiled for AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn sweep_avx2(
-    grid: &Grid,
-    h: &[f64],
-    q: &[f64],
-    a: f64,
-    faces: &mut Faces,
-    march: Option<&mut March>,
-) -> Sweep {
-    sweep_passes(grid, h, q, a, faces, march)
 }
 
 /// The passes of [`sweep`], for any CPU (the baseline build); the rates go to `march` if
