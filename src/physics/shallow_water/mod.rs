@@ -514,7 +514,8 @@ const STAGES: [Stage; 10] = [
     stage(1.0 / 6.0, 1.0 / 6.0),
     stage(2.0 / 6.0, 1.0 / 6.0),
     stage(3.0 / 6.0, 1.0 / 6.0),
-    stage(4.0 / 6.0, 1.0 / 6.0),
+    // Register 1 restarts from U0 after the fifth stage: nothing moves it ahead.
+    stage(4.0 / 6.0, 0.0),
     stage(1.0 / 3.0, 1.0 / 6.0),
     stage(1.0 / 2.0, 1.0 / 6.0),
     stage(2.0 / 3.0, 1.0 / 6.0),
