@@ -79,13 +79,15 @@ macro_rules! builds {
 
 #[cfg(test)]
 mod exact;
+mod lanes;
 pub mod scheme;
 #[cfg(test)]
 mod tests;
 
 use crate::physics::base::BaseAcceleration;
 use crate::solver::SolveError;
-use scheme::{Faces, Grid, March, Rates, lane_sum, lane_sum_by, rates, sweep_passes, velocity};
+use lanes::{Survey, decayed, faster, lane_sum, lane_sum_by, settle};
+use scheme::{Faces, Grid, March, Rates, rates, sweep_passes, velocity};
 
 /// Courant number of a substep against the largest interface wave speed. The MUSCL-HLL
 /// forward-Euler stage keeps depths non-negative up to 1/2 (each cell average is the mean of
@@ -267,7 +269,6 @@ impl Channel {
         let speed = |h: f64, q: f64| velocity(q, h, dry).abs() + (self.g_e * h.max(0.0)).sqrt();
         // In eight lanes, without branches (vectorised); a NaN is passed over, as f64::max
         // does (the step then refuses the state).
-        let faster = |m: f64, s: f64| if s > m { s } else { m };
         let mut lanes = [0.0; 8];
         let (hs, qs) = (f.depth.chunks_exact(8), f.discharge.chunks_exact(8));
         let rest = hs.remainder().iter().zip(qs.remainder());
@@ -303,10 +304,7 @@ impl Channel {
         // times the momentum (the sum of the discharges times dx) before each half.
         let drag_loss = |p: f64| (1.0 - decay) * p;
         // U0 = the state after the first drag half: the depths are f's.
-        let p0 = lane_sum(&f.discharge);
-        for (a, &q) in w.q0.iter_mut().zip(&f.discharge) {
-            *a = q * decay;
-        }
+        let p0 = decayed(&f.discharge, &mut w.q0, decay);
         let mut impulse = drag_loss(p0 * dx);
         let mut fastest: f64 = 0.0;
         let mut wall = 0.0;
@@ -337,20 +335,12 @@ impl Channel {
                 first: k == 0,
                 next: [&mut next_h[..n], &mut next_q[..n]],
                 sum: [&mut sum_h[..n], &mut sum_q[..n]],
+                restart: stage.restart.map(|share| ([h0, q0], share)),
             };
             let (hk, qk): (&[f64], &[f64]) = if k == 0 { (h0, q0) } else { (h1, q1) };
             let s = sweep_passes(&grid, hk, qk, a, faces, Some(&mut march));
             std::mem::swap(h1, next_h);
             std::mem::swap(q1, next_q);
-            if k == RESTART {
-                // U1 = U0 + (2/3) A: the convex combination 3/5 U0 + 2/5 U1 of the scheme.
-                for ((h1, &a), &h0) in h1.iter_mut().zip(sum_h.iter()).zip(h0) {
-                    *h1 = h0 + RESTART_SHARE * a;
-                }
-                for ((q1, &a), &q0) in q1.iter_mut().zip(sum_q.iter()).zip(q0) {
-                    *q1 = q0 + RESTART_SHARE * a;
-                }
-            }
             fastest = fastest.max(s.speed);
             if s.speed > limit {
                 return Err(s.speed);
@@ -363,27 +353,19 @@ impl Channel {
             // reconstruction as a bottom does.)
             work -= stage.weight * dt * a * s.mass_flux * dx;
         }
-        // U = U0 + A, into register 1 (swapped into the state below).
-        for ((h1, &a), &h0) in h1.iter_mut().zip(sum_h.iter()).zip(h0) {
-            *h1 = h0 + a;
-        }
-        for ((q1, &a), &q0) in q1.iter_mut().zip(sum_q.iter()).zip(q0) {
-            *q1 = q0 + a;
-        }
+        // Register 1 holds U = U0 + A, the last stage's restart.
         std::mem::swap(&mut f.depth, h1);
         std::mem::swap(&mut f.discharge, q1);
         impulse += wall;
         // The second drag half, then the films: a dry cell's discharge goes to the bottom.
         let dry = grid.dry;
-        let p1 = lane_sum(&f.discharge);
-        // Without branches (vectorised): finiteness, the drag, the shallowest depth.
-        let mut finite = true;
-        let mut shallowest = f64::INFINITY;
-        for (h, q) in f.depth.iter().zip(f.discharge.iter_mut()) {
-            finite &= h.is_finite() & q.is_finite();
-            *q *= decay;
-            shallowest = if *h < shallowest { *h } else { shallowest };
-        }
+        // In one pass (vectorised): the drag, the momentum before it, the shallowest depth,
+        // finiteness.
+        let Survey {
+            sum: p1,
+            shallowest,
+            finite,
+        } = settle(&f.depth, &mut f.discharge, decay);
         let mut stopped = 0.0;
         if shallowest < dry {
             for (h, q) in f.depth.iter_mut().zip(f.discharge.iter_mut()) {
@@ -484,8 +466,7 @@ builds! {
 /// U1 = 3/5 U0 + 2/5 U1 (= U0 + (2/3) A, A the weighted sum of the rates so far); stages
 /// 6-9 march on; the tenth only adds its rate: U = U0 + A.
 const RATIO: f64 = 6.0;
-/// The stage after which register 1 restarts from U0 (0-based), and A's share in it.
-const RESTART: usize = 4;
+/// A's share in register 1 when it restarts from U0 after the fifth stage.
 const RESTART_SHARE: f64 = 2.0 / 3.0;
 
 /// A stage: its time in the substep and how far it moves register 1 (fractions of dt), and
@@ -496,6 +477,8 @@ struct Stage {
     at: f64,
     ahead: f64,
     weight: f64,
+    /// Register 1 after the stage is U0 + share A instead ([`March::restart`]).
+    restart: Option<f64>,
 }
 
 const fn stage(at: f64, ahead: f64) -> Stage {
@@ -503,6 +486,15 @@ const fn stage(at: f64, ahead: f64) -> Stage {
         at,
         ahead,
         weight: 0.1,
+        restart: None,
+    }
+}
+
+/// A stage after which register 1 is U0 + share A.
+const fn restart(at: f64, share: f64) -> Stage {
+    Stage {
+        restart: Some(share),
+        ..stage(at, 0.0)
     }
 }
 
@@ -514,13 +506,14 @@ const STAGES: [Stage; 10] = [
     stage(1.0 / 6.0, 1.0 / 6.0),
     stage(2.0 / 6.0, 1.0 / 6.0),
     stage(3.0 / 6.0, 1.0 / 6.0),
-    // Register 1 restarts from U0 after the fifth stage: nothing moves it ahead.
-    stage(4.0 / 6.0, 0.0),
+    // Register 1 restarts from U0 after the fifth stage: U0 + (2/3) A.
+    restart(4.0 / 6.0, RESTART_SHARE),
     stage(1.0 / 3.0, 1.0 / 6.0),
     stage(1.0 / 2.0, 1.0 / 6.0),
     stage(2.0 / 3.0, 1.0 / 6.0),
     stage(5.0 / 6.0, 1.0 / 6.0),
-    stage(1.0, 0.0),
+    // The tenth only adds its rate: U = U0 + A.
+    restart(1.0, 1.0),
 ];
 
 /// What a communication step did, per unit breadth and density.

@@ -31,6 +31,8 @@
 //! - Walls: mirror ghost cells, w and H even, q odd; the HLL flux of two mirror states has no
 //!   mass flux and the momentum flux g_e H^2/2 + H u (u - s), the wall pressure.
 
+use super::lanes::{faster, lane_sum, larger, smaller, whole_chunks};
+
 /// The discretisation: cells across the tank, their width, gravity with the dispersion
 /// correction, and the depth below which a cell counts as dry.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,26 +68,6 @@ impl Rates {
             speed: 0.0,
         }
     }
-}
-
-/// The smaller and the larger of two numbers, one instruction each (f64::min and max take
-/// seven, for NaN). A NaN anywhere in the state is refused at the end of the substep, so
-/// these need not handle it; whichever number they return then, the step is refused.
-#[inline(always)]
-fn smaller(a: f64, b: f64) -> f64 {
-    if a < b { a } else { b }
-}
-
-#[inline(always)]
-fn larger(a: f64, b: f64) -> f64 {
-    if a > b { a } else { b }
-}
-
-/// The larger of a speed met so far and a new one; a NaN new one is passed over, as
-/// f64::max does.
-#[inline(always)]
-fn faster(speed: f64, new: f64) -> f64 {
-    if new > speed { new } else { speed }
 }
 
 /// Minmod of the left and right differences: the smaller in magnitude if they have one sign,
@@ -174,10 +156,6 @@ fn hll(l: Side, r: Side, g: f64, root_g: f64, dry: f64) -> (f64, f64, f64) {
     }
 }
 
-/// Width of the chunks the passes over the cells and the interfaces run in: a whole number of
-/// vectors of every build (8 AVX-512F lanes, 2 AVX2 vectors, 4 SSE2 ones).
-const W: usize = 8;
-
 /// The faces of the interior cells 1 + a .. 1 + b for `part` = a..b, from the depths `h` and
 /// velocities `u` of all cells, into `faces` = [ahead_h, ahead_u, behind_h, behind_u] by
 /// interface: cell c's left face is the state ahead of interface c, its right face the state
@@ -238,50 +216,6 @@ fn fluxes(
     }
 }
 
-/// 0..len as one range of a whole number of chunks of W and, if len is not a multiple of W,
-/// the last W elements again (overlapping the first range, whose elements there it computes
-/// again from the same inputs, to the same bits); below W elements, 0..len; for none, no range
-/// (a pass over the interior cells of one cell must not read its neighbours). A loop over each
-/// then runs whole vectors only, no scalar remainder (at 200 cells, the remainders of the
-/// face and flux passes cost about as much as three chunks of eight).
-fn whole_chunks(len: usize) -> impl Iterator<Item = std::ops::Range<usize>> {
-    let rest = len % W;
-    // None for no elements; below W elements, or a whole number of chunks, one range.
-    let (first, tail) = if len == 0 {
-        (None, None)
-    } else if len < W || rest == 0 {
-        (Some(0..len), None)
-    } else {
-        (Some(0..len - rest), Some(len - W..len))
-    };
-    first.into_iter().chain(tail)
-}
-
-/// The sum of `x` in eight lanes, element i into lane i mod 8, the lanes then added pairwise
-/// in a fixed order: the same operations on every build, so the same bits, and no chain of
-/// dependent additions as long as `x` (which a sum in order is, at 3-4 cycles an addition).
-#[inline(always)]
-pub fn lane_sum(x: &[f64]) -> f64 {
-    lane_sum_by(x.len(), |i| x[i])
-}
-
-/// The sum of `term(i)` for i in 0..n, in eight lanes as [`lane_sum`].
-#[inline(always)]
-pub fn lane_sum_by(n: usize, term: impl Fn(usize) -> f64) -> f64 {
-    let mut lanes = [0.0; 8];
-    let whole = n - n % 8;
-    for k in (0..whole).step_by(8) {
-        for (j, l) in lanes.iter_mut().enumerate() {
-            *l += term(k + j);
-        }
-    }
-    for (j, l) in lanes.iter_mut().enumerate().take(n - whole) {
-        *l += term(whole + j);
-    }
-    let [a, b, c, d, e, f, g, h] = lanes;
-    ((a + e) + (c + g)) + ((b + f) + (d + h))
-}
-
 /// What a pass of the right-hand side gives besides the cell rates.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sweep {
@@ -308,6 +242,9 @@ pub struct March<'a> {
     /// U' (depths, discharges), written; A, written (first) or added to.
     pub next: [&'a mut [f64]; 2],
     pub sum: [&'a mut [f64]; 2],
+    /// Instead of moving ahead, U' = U0 + share A (A with this stage's share added): the
+    /// restart of register 1 from U0 (depths, discharges) and the substep's last stage.
+    pub restart: Option<([&'a [f64]; 2], f64)>,
 }
 
 /// The faces of a cell of depth `depth` and velocity `u` from the differences of the surface
@@ -405,7 +342,8 @@ builds! {
 
 /// Every build of [`sweep_passes`] this CPU can run, by name, each given to `check` with what
 /// it left in `faces` and, run again with a [`March`] (`first` or not; A starting from
-/// `start` when not), the stage's next register 1 and A (the tests compare them).
+/// `start` when not; a restart from U0 = (`start`, `start`) with the share given, if any),
+/// the stage's next register 1 and A (the tests compare them).
 #[cfg(test)]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn each_build(
@@ -415,6 +353,7 @@ pub(super) fn each_build(
     a: f64,
     faces: &mut Faces,
     first: bool,
+    restart: Option<f64>,
     start: &[f64],
     mut check: impl FnMut(&str, Sweep, &Faces, [&[f64]; 4]),
 ) {
@@ -430,6 +369,7 @@ pub(super) fn each_build(
             first,
             next: [&mut next_h, &mut next_q],
             sum: [&mut sum_h, &mut sum_q],
+            restart: restart.map(|share| ([start, start], share)),
         };
         let s_march = build(grid, h, q, a, &mut Faces::new(n), Some(&mut march));
         assert_eq!(s, s_march, "{name}: the march changes the sweep");
@@ -548,31 +488,50 @@ pub(super) fn sweep_passes(
             first,
             next: [next_h, next_q],
             sum: [sum_h, sum_q],
+            restart,
         }) => {
             let (ahead, weight) = (*ahead, *weight);
             let (next_h, next_q) = (&mut next_h[..n], &mut next_q[..n]);
             let (sum_h, sum_q) = (&mut sum_h[..n], &mut sum_q[..n]);
             let next = next_h.iter_mut().zip(next_q.iter_mut());
             let sums = sum_h.iter_mut().zip(sum_q.iter_mut());
-            let cells = next.zip(sums).zip(h.iter().zip(q)).zip(fluxes);
-            // Two loops, not a branch per cell: A written or added to.
-            if *first {
-                for ((((nh, nq), (sh, sq)), (&h, &q)), (f, m)) in cells {
-                    let dh = -(f[1] - f[0]) * inv_dx;
-                    let dq = -(m[1] - m[0]) * inv_dx - a * h;
-                    *nh = h + ahead * dh;
-                    *nq = q + ahead * dq;
-                    *sh = weight * dh;
-                    *sq = weight * dq;
+            // Three loops, not a branch per cell: A written or added to, U' ahead of U or
+            // restarted from U0.
+            match (*first, restart) {
+                (true, _) => {
+                    let cells = next.zip(sums).zip(h.iter().zip(q)).zip(fluxes);
+                    for ((((nh, nq), (sh, sq)), (&h, &q)), (f, m)) in cells {
+                        let dh = -(f[1] - f[0]) * inv_dx;
+                        let dq = -(m[1] - m[0]) * inv_dx - a * h;
+                        *nh = h + ahead * dh;
+                        *nq = q + ahead * dq;
+                        *sh = weight * dh;
+                        *sq = weight * dq;
+                    }
                 }
-            } else {
-                for ((((nh, nq), (sh, sq)), (&h, &q)), (f, m)) in cells {
-                    let dh = -(f[1] - f[0]) * inv_dx;
-                    let dq = -(m[1] - m[0]) * inv_dx - a * h;
-                    *nh = h + ahead * dh;
-                    *nq = q + ahead * dq;
-                    *sh += weight * dh;
-                    *sq += weight * dq;
+                (false, None) => {
+                    let cells = next.zip(sums).zip(h.iter().zip(q)).zip(fluxes);
+                    for ((((nh, nq), (sh, sq)), (&h, &q)), (f, m)) in cells {
+                        let dh = -(f[1] - f[0]) * inv_dx;
+                        let dq = -(m[1] - m[0]) * inv_dx - a * h;
+                        *nh = h + ahead * dh;
+                        *nq = q + ahead * dq;
+                        *sh += weight * dh;
+                        *sq += weight * dq;
+                    }
+                }
+                (false, Some(([h0, q0], share))) => {
+                    let (h0, q0, share) = (&h0[..n], &q0[..n], *share);
+                    let origin = h.iter().zip(h0.iter().zip(q0));
+                    let cells = next.zip(sums).zip(origin).zip(fluxes);
+                    for ((((nh, nq), (sh, sq)), (&h, (&h0, &q0))), (f, m)) in cells {
+                        let dh = -(f[1] - f[0]) * inv_dx;
+                        let dq = -(m[1] - m[0]) * inv_dx - a * h;
+                        *sh += weight * dh;
+                        *sq += weight * dq;
+                        *nh = h0 + share * *sh;
+                        *nq = q0 + share * *sq;
+                    }
                 }
             }
         }
