@@ -2,7 +2,7 @@
 //! docs/SHALLOW_WATER.md): the lab tank at Lambda = 0.02 at resonance, boundary-layer
 //! damping, 10 ms communication steps, from rest.
 //!
-//! `cargo run --release --example swe_cost -- [CELLS] [SECONDS]` (200 cells, 10 s): wall time
+//! `cargo run --release --example swe_cost -- [CELLS] [SECONDS]` (150 cells, 10 s): wall time
 //! per simulated second, the real-time factor, the substeps per simulated second, the time per
 //! cell and stage, and a hash of the final state (equal hashes: bit-identical results).
 
@@ -20,7 +20,7 @@ fn arg<T: std::str::FromStr>(k: usize, default: T) -> Result<T, String> {
 }
 
 fn main() -> Result<(), String> {
-    let cells: usize = arg(1, 200)?;
+    let cells: usize = arg(1, 150)?;
     let seconds: f64 = arg(2, 10.0)?;
     let tank = Tank::TABLE_2_1;
     let ch = Channel::new(tank.length, tank.depth, tank.g, cells);
