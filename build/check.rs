@@ -139,7 +139,9 @@ fn check(
     let want_initial: Vec<usize> = vars
         .iter()
         .filter(|v| {
-            (v.causality == "output" && v.initial.as_deref() != Some("exact"))
+            // Model Exchange's states and derivatives are the continuous locals.
+            (matches!(v.causality.as_str(), "output" | "local")
+                && v.initial.as_deref() != Some("exact"))
                 || v.causality == "calculatedParameter"
         })
         .map(|v| v.index)

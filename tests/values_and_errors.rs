@@ -248,16 +248,17 @@ fn instantiate_refuses_what_it_cannot_serve() {
     let guid = CString::new(GUID).unwrap();
     let wrong = CString::new("{00000000-0000-0000-0000-000000000000}").unwrap();
     unsafe {
+        // Neither fmi2ModelExchange (0) nor fmi2CoSimulation (1).
         let c = lib.fmi2Instantiate(
             name.as_ptr(),
-            fmi_sys::fmi2::fmi2Type_fmi2ModelExchange,
+            7,
             guid.as_ptr(),
             std::ptr::null(),
             &*callbacks,
             0,
             0,
         );
-        assert!(c.is_null(), "Model Exchange");
+        assert!(c.is_null(), "unknown fmuType");
         let c = lib.fmi2Instantiate(
             name.as_ptr(),
             fmi_sys::fmi2::fmi2Type_fmi2CoSimulation,

@@ -1,15 +1,21 @@
-//! The FMI 2.0 Co-Simulation state machine as a table: the phases an instance can be in, and
-//! for every function the phases in which it may be called (its mask). The exports check the
-//! mask before anything else, in one place.
+//! The FMI 2.0 state machines (Co-Simulation and Model Exchange) as a table: the phases an
+//! instance can be in, and for every function the phases in which it may be called (its mask).
+//! The exports check the mask before anything else, in one place. A Co-Simulation instance
+//! runs in StepComplete, a Model Exchange one in EventMode and ContinuousTimeMode: a function
+//! of the other interface is refused by its mask, with the way to the right instance.
 
-/// Phases of the FMI 2.0 Co-Simulation state machine this FMU can be in (it never runs
-/// asynchronously, and a refused step leaves it in StepComplete at the step's start).
+/// Phases of the FMI 2.0 state machines this FMU can be in (it never runs asynchronously, and
+/// a refused step leaves it in StepComplete at the step's start).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Phase {
     Instantiated,
     InitializationMode,
     StepComplete,
     Terminated,
+    /// Model Exchange: after fmi2ExitInitializationMode and fmi2EnterEventMode.
+    EventMode,
+    /// Model Exchange: after fmi2EnterContinuousTimeMode, while the host integrates.
+    ContinuousTimeMode,
     /// After an internal error (a caught panic): only fmi2Reset and fmi2FreeInstance work.
     Broken,
 }
@@ -21,11 +27,22 @@ pub mod allow {
     pub const STEP_COMPLETE: u8 = 4;
     pub const TERMINATED: u8 = 8;
     pub const BROKEN: u8 = 16;
+    pub const EVENT: u8 = 32;
+    pub const CONTINUOUS: u8 = 64;
     pub const NONE: u8 = 0;
-    pub const ANY: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE | TERMINATED;
-    pub const GET: u8 = INITIALIZATION | STEP_COMPLETE | TERMINATED;
-    pub const SET: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE;
+    /// Model Exchange's running phases.
+    pub const RUNNING_ME: u8 = EVENT | CONTINUOUS;
+    pub const ANY: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE | TERMINATED | RUNNING_ME;
+    pub const GET: u8 = INITIALIZATION | STEP_COMPLETE | TERMINATED | RUNNING_ME;
+    /// Inputs may be set while the host integrates; the table says which variables when.
+    pub const SET: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE | RUNNING_ME;
+    /// Integer and Boolean variables are discrete: not in continuous-time mode.
+    pub const SET_DISCRETE: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE | EVENT;
+    /// Co-Simulation's input derivatives.
+    pub const SET_CS: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE;
     pub const STATUS: u8 = STEP_COMPLETE | TERMINATED;
+    /// Model Exchange's state queries.
+    pub const STATES: u8 = RUNNING_ME | TERMINATED;
 }
 
 impl Phase {
@@ -36,7 +53,17 @@ impl Phase {
             Phase::StepComplete => allow::STEP_COMPLETE,
             Phase::Terminated => allow::TERMINATED,
             Phase::Broken => allow::BROKEN,
+            Phase::EventMode => allow::EVENT,
+            Phase::ContinuousTimeMode => allow::CONTINUOUS,
         }
+    }
+
+    /// Whether the instance has been initialised and not reset (a simulation exists).
+    pub const fn initialised(self) -> bool {
+        matches!(
+            self,
+            Phase::StepComplete | Phase::Terminated | Phase::EventMode | Phase::ContinuousTimeMode
+        )
     }
 
     fn describe(mask: u8) -> String {
@@ -45,6 +72,8 @@ impl Phase {
             (allow::INITIALIZATION, "InitializationMode"),
             (allow::STEP_COMPLETE, "StepComplete"),
             (allow::TERMINATED, "Terminated"),
+            (allow::EVENT, "EventMode"),
+            (allow::CONTINUOUS, "ContinuousTimeMode"),
         ];
         let list: Vec<&str> = names
             .iter()
@@ -65,11 +94,26 @@ impl Phase {
             Phase::Instantiated if allowed & INITIALIZATION != 0 => {
                 " Call fmi2EnterInitializationMode first."
             }
-            Phase::Instantiated if allowed & STEP_COMPLETE != 0 => {
+            Phase::Instantiated if allowed & (STEP_COMPLETE | RUNNING_ME) != 0 => {
                 " Initialise first: fmi2SetupExperiment, fmi2EnterInitializationMode and fmi2ExitInitializationMode (again after fmi2Reset)."
             }
-            Phase::InitializationMode if allowed & STEP_COMPLETE != 0 => {
+            Phase::InitializationMode if allowed & (STEP_COMPLETE | RUNNING_ME) != 0 => {
                 " Call fmi2ExitInitializationMode first."
+            }
+            Phase::StepComplete if allowed & RUNNING_ME != 0 => {
+                " This is a Co-Simulation instance: Model Exchange functions need an instance made by fmi2Instantiate with fmuType fmi2ModelExchange."
+            }
+            Phase::EventMode | Phase::ContinuousTimeMode
+                if allowed & STEP_COMPLETE != 0 && allowed & RUNNING_ME == 0 =>
+            {
+                " This is a Model Exchange instance: Co-Simulation functions need an instance made by fmi2Instantiate with fmuType fmi2CoSimulation."
+            }
+            Phase::EventMode if allowed & CONTINUOUS != 0 => {
+                " Call fmi2EnterContinuousTimeMode first (after fmi2NewDiscreteStates reports no new discrete states needed)."
+            }
+            Phase::ContinuousTimeMode if allowed & EVENT != 0 => " Call fmi2EnterEventMode first.",
+            Phase::EventMode | Phase::ContinuousTimeMode if allowed & INSTANTIATED != 0 => {
+                " That is only possible before initialisation: call fmi2Reset first."
             }
             Phase::InitializationMode | Phase::StepComplete if allowed & INSTANTIATED != 0 => {
                 " That is only possible before initialisation: call fmi2Reset first."
@@ -120,10 +164,6 @@ const fn call(name: &'static str, allowed: u8) -> Call {
     }
 }
 
-/// `{model}` becomes the FMU's modelIdentifier in the refusal.
-const CO_SIMULATION_ONLY: &str =
-    "{model}.fmu is a Co-Simulation FMU; Model Exchange is not provided";
-
 const fn never(name: &'static str, why: &'static str) -> Call {
     Call {
         name,
@@ -138,7 +178,7 @@ pub const ENTER_INITIALIZATION_MODE: Call =
     call("fmi2EnterInitializationMode", allow::INSTANTIATED);
 pub const EXIT_INITIALIZATION_MODE: Call =
     call("fmi2ExitInitializationMode", allow::INITIALIZATION);
-pub const TERMINATE: Call = call("fmi2Terminate", allow::STEP_COMPLETE);
+pub const TERMINATE: Call = call("fmi2Terminate", allow::STEP_COMPLETE | allow::RUNNING_ME);
 /// The one way out of an internal error.
 pub const RESET: Call = call("fmi2Reset", allow::ANY | allow::BROKEN);
 pub const GET_REAL: Call = call("fmi2GetReal", allow::GET);
@@ -146,10 +186,10 @@ pub const GET_INTEGER: Call = call("fmi2GetInteger", allow::GET);
 pub const GET_BOOLEAN: Call = call("fmi2GetBoolean", allow::GET);
 pub const GET_STRING: Call = call("fmi2GetString", allow::GET);
 pub const SET_REAL: Call = call("fmi2SetReal", allow::SET);
-pub const SET_INTEGER: Call = call("fmi2SetInteger", allow::SET);
-pub const SET_BOOLEAN: Call = call("fmi2SetBoolean", allow::SET);
-pub const SET_STRING: Call = call("fmi2SetString", allow::SET);
-pub const SET_REAL_INPUT_DERIVATIVES: Call = call("fmi2SetRealInputDerivatives", allow::SET);
+pub const SET_INTEGER: Call = call("fmi2SetInteger", allow::SET_DISCRETE);
+pub const SET_BOOLEAN: Call = call("fmi2SetBoolean", allow::SET_DISCRETE);
+pub const SET_STRING: Call = call("fmi2SetString", allow::SET_DISCRETE);
+pub const SET_REAL_INPUT_DERIVATIVES: Call = call("fmi2SetRealInputDerivatives", allow::SET_CS);
 pub const GET_REAL_OUTPUT_DERIVATIVES: Call = call("fmi2GetRealOutputDerivatives", allow::STATUS);
 pub const DO_STEP: Call = call("fmi2DoStep", allow::STEP_COMPLETE);
 pub const CANCEL_STEP: Call = never(
@@ -167,23 +207,20 @@ pub const FREE_FMU_STATE: Call = call("fmi2FreeFMUstate", allow::ANY);
 pub const SERIALIZED_FMU_STATE_SIZE: Call = call("fmi2SerializedFMUstateSize", allow::ANY);
 pub const SERIALIZE_FMU_STATE: Call = call("fmi2SerializeFMUstate", allow::ANY);
 pub const DE_SERIALIZE_FMU_STATE: Call = call("fmi2DeSerializeFMUstate", allow::ANY);
-pub const GET_DIRECTIONAL_DERIVATIVE: Call = never(
-    "fmi2GetDirectionalDerivative",
-    "providesDirectionalDerivative is false",
-);
-pub const ENTER_EVENT_MODE: Call = never("fmi2EnterEventMode", CO_SIMULATION_ONLY);
-pub const NEW_DISCRETE_STATES: Call = never("fmi2NewDiscreteStates", CO_SIMULATION_ONLY);
-pub const ENTER_CONTINUOUS_TIME_MODE: Call =
-    never("fmi2EnterContinuousTimeMode", CO_SIMULATION_ONLY);
-pub const COMPLETED_INTEGRATOR_STEP: Call =
-    never("fmi2CompletedIntegratorStep", CO_SIMULATION_ONLY);
-pub const SET_TIME: Call = never("fmi2SetTime", CO_SIMULATION_ONLY);
-pub const SET_CONTINUOUS_STATES: Call = never("fmi2SetContinuousStates", CO_SIMULATION_ONLY);
-pub const GET_DERIVATIVES: Call = never("fmi2GetDerivatives", CO_SIMULATION_ONLY);
-pub const GET_EVENT_INDICATORS: Call = never("fmi2GetEventIndicators", CO_SIMULATION_ONLY);
-pub const GET_CONTINUOUS_STATES: Call = never("fmi2GetContinuousStates", CO_SIMULATION_ONLY);
+/// Model Exchange (masks as in the FMI 2.0 standard's state machine; the state queries need
+/// the simulation that fmi2ExitInitializationMode builds, so they start in EventMode).
+pub const GET_DIRECTIONAL_DERIVATIVE: Call = call("fmi2GetDirectionalDerivative", allow::STATES);
+pub const ENTER_EVENT_MODE: Call = call("fmi2EnterEventMode", allow::RUNNING_ME);
+pub const NEW_DISCRETE_STATES: Call = call("fmi2NewDiscreteStates", allow::EVENT);
+pub const ENTER_CONTINUOUS_TIME_MODE: Call = call("fmi2EnterContinuousTimeMode", allow::EVENT);
+pub const COMPLETED_INTEGRATOR_STEP: Call = call("fmi2CompletedIntegratorStep", allow::CONTINUOUS);
+pub const SET_TIME: Call = call("fmi2SetTime", allow::RUNNING_ME);
+pub const SET_CONTINUOUS_STATES: Call = call("fmi2SetContinuousStates", allow::CONTINUOUS);
+pub const GET_DERIVATIVES: Call = call("fmi2GetDerivatives", allow::STATES);
+pub const GET_EVENT_INDICATORS: Call = call("fmi2GetEventIndicators", allow::STATES);
+pub const GET_CONTINUOUS_STATES: Call = call("fmi2GetContinuousStates", allow::STATES);
 pub const GET_NOMINALS_OF_CONTINUOUS_STATES: Call =
-    never("fmi2GetNominalsOfContinuousStates", CO_SIMULATION_ONLY);
+    call("fmi2GetNominalsOfContinuousStates", allow::STATES);
 
 #[cfg(test)]
 mod tests {
@@ -208,11 +245,25 @@ mod tests {
             (Phase::Terminated, DO_STEP, "fmi2Reset"),
             (Phase::Broken, DO_STEP, "fmi2Reset"),
             (Phase::StepComplete, CANCEL_STEP, "asynchronous"),
+            (Phase::StepComplete, SET_TIME, "fmi2ModelExchange"),
+            (Phase::EventMode, DO_STEP, "fmi2CoSimulation"),
             (
-                Phase::StepComplete,
-                SET_TIME,
-                "TLD.fmu is a Co-Simulation FMU",
+                Phase::EventMode,
+                SET_CONTINUOUS_STATES,
+                "fmi2EnterContinuousTimeMode first",
             ),
+            (
+                Phase::ContinuousTimeMode,
+                NEW_DISCRETE_STATES,
+                "fmi2EnterEventMode first",
+            ),
+            (
+                Phase::InitializationMode,
+                GET_DERIVATIVES,
+                "fmi2ExitInitializationMode first",
+            ),
+            (Phase::Instantiated, SET_TIME, "Initialise first"),
+            (Phase::ContinuousTimeMode, SETUP_EXPERIMENT, "fmi2Reset"),
         ];
         for (phase, call, hint) in cases {
             let message = phase.refusal(&call, "TLD");

@@ -4,7 +4,8 @@
 //! ```text
 //! tag (4 bytes, the FMU's) | format version u16 | reserved u16 | GUID length u16 | GUID bytes
 //!        | payload length u32 | payload | FNV-1a 64 checksum of everything before it
-//! payload: phase u8 | flags u8 | time, tolerance, start, stop f64 | the slave's part
+//! payload: phase u8 (0 Instantiated, 1 InitializationMode, 2 StepComplete, 3 Terminated,
+//!          4 EventMode, 5 ContinuousTimeMode) | flags u8 | time, tolerance, start, stop f64 | the slave's part
 //! flags: bit 0 the slave's own, bit 1 tolerance defined, bit 2 stop time defined
 //! ```
 //! All numbers little-endian. The slave's part is written and read by the slave
@@ -42,6 +43,8 @@ fn phase_code(phase: Phase) -> u8 {
         Phase::InitializationMode => 1,
         Phase::StepComplete => 2,
         Phase::Terminated | Phase::Broken => 3,
+        Phase::EventMode => 4,
+        Phase::ContinuousTimeMode => 5,
     }
 }
 
@@ -147,6 +150,8 @@ pub fn decode<'a>(
         1 => Phase::InitializationMode,
         2 => Phase::StepComplete,
         3 => Phase::Terminated,
+        4 => Phase::EventMode,
+        5 => Phase::ContinuousTimeMode,
         other => return Err(format!("unknown state code {other}")),
     };
     let flags = p.u8()?;

@@ -12,8 +12,16 @@ use crate::logger::Logger;
 use crate::slave::{Context, Slave};
 use crate::status::{Refusal, Reply, Status, refuse};
 
+/// The interface an instance was made for (fmi2Instantiate's fmuType).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    CoSimulation,
+    ModelExchange,
+}
+
 pub struct Instance<S> {
     magic: u64,
+    pub kind: Kind,
     name: CString,
     logger: Logger,
     logging_on: bool,
@@ -23,9 +31,10 @@ pub struct Instance<S> {
 }
 
 impl<S: Slave> Instance<S> {
-    pub fn new(name: CString, logger: Logger, logging_on: bool) -> Self {
+    pub fn new(name: CString, logger: Logger, logging_on: bool, kind: Kind) -> Self {
         Instance {
             magic: S::MARK,
+            kind,
             name,
             logger,
             logging_on,
@@ -178,7 +187,19 @@ impl<S: Slave> Instance<S> {
 
     pub fn exit_initialization_mode(&mut self) -> Reply {
         let warnings = self.slave.initialise(&self.context)?;
-        self.context.phase = Phase::StepComplete;
+        self.context.phase = match self.kind {
+            Kind::CoSimulation => Phase::StepComplete,
+            Kind::ModelExchange => {
+                if let Err(why) = self.slave.offers_model_exchange() {
+                    // Back to where the host was: it may choose another model and try again.
+                    self.slave.uninitialise();
+                    return Err(refuse(format!(
+                        "fmi2ExitInitializationMode: Model Exchange is not offered for these parameters: {why}"
+                    )));
+                }
+                Phase::EventMode
+            }
+        };
         for w in &warnings {
             self.log(Status::Warning, log_category::LOG_STATUS_WARNING, w);
         }
@@ -273,8 +294,24 @@ impl<S: Slave> Instance<S> {
         )
     }
 
-    /// The context and slave `bytes` describe, checked completely.
-    fn restored(bytes: &[u8]) -> Result<(Context, S), Refusal> {
+    /// The context and slave `bytes` describe, checked completely (a running state of one
+    /// interface does not restore into an instance of the other).
+    fn restored(&self, bytes: &[u8]) -> Result<(Context, S), Refusal> {
+        let (context, slave) = Self::restored_any(bytes)?;
+        let me_phase = matches!(context.phase, Phase::EventMode | Phase::ContinuousTimeMode);
+        let cs_phase = context.phase == Phase::StepComplete;
+        match self.kind {
+            Kind::CoSimulation if me_phase => Err(frame::unusable(
+                "it was saved by a Model Exchange instance; restore it into one made with fmi2ModelExchange",
+            )),
+            Kind::ModelExchange if cs_phase => Err(frame::unusable(
+                "it was saved by a Co-Simulation instance; restore it into one made with fmi2CoSimulation",
+            )),
+            _ => Ok((context, slave)),
+        }
+    }
+
+    fn restored_any(bytes: &[u8]) -> Result<(Context, S), Refusal> {
         let t = S::TABLE;
         let read = || -> Result<(Context, S), String> {
             let (common, mut part) = frame::decode(
@@ -297,13 +334,13 @@ impl<S: Slave> Instance<S> {
     }
 
     /// Check a saved state completely, without applying it.
-    pub fn check_saved(bytes: &[u8]) -> Result<(), Refusal> {
-        Self::restored(bytes).map(|_| ())
+    pub fn check_saved(&self, bytes: &[u8]) -> Result<(), Refusal> {
+        self.restored(bytes).map(|_| ())
     }
 
     /// Become the instance `bytes` describes; on any error nothing changes.
     pub fn load(&mut self, bytes: &[u8]) -> Reply {
-        let (context, slave) = Self::restored(bytes)?;
+        let (context, slave) = self.restored(bytes)?;
         self.context = context;
         self.slave = slave;
         Ok(Status::Ok)

@@ -1,9 +1,10 @@
-//! The FMI 2.0 Co-Simulation layer every FMU of this workspace shares: the only place that
+//! The FMI 2.0 Co-Simulation and Model Exchange layer every FMU of this workspace shares: the only place that
 //! speaks fmi2. An FMU implements [`Slave`] (its variables, its model) and invokes
 //! [`export_fmi2!`] once with its type; the macro emits the `extern "C"` fmi2* functions, each a
 //! call of the generic body in [`exports`] monomorphised for that slave (no dynamic dispatch,
 //! no cost over hand-written exports).
 //!
+//! - `continuous`: the Model Exchange side of the slave contract (states, derivatives, events);
 //! - `calls`: the call-sequence table (phases, one mask per function), checked first in every
 //!   call by the guard in `exports`;
 //! - `instance`: what every instance holds (name, logger, phase, experiment, time) around the
@@ -13,6 +14,7 @@
 //! - `host`, `logger`, `status`: host pointers, the host's logger, statuses and refusals.
 
 pub mod calls;
+pub mod continuous;
 pub mod description;
 pub mod exports;
 pub mod frame;
@@ -22,7 +24,9 @@ pub mod logger;
 pub mod slave;
 pub mod status;
 
+pub use continuous::{Continuous, EventUpdate};
 pub use fmi_sys;
+pub use instance::Kind;
 pub use slave::{Context, Slave};
 pub use status::{Refusal, Reply, Status, refuse};
 
@@ -34,7 +38,6 @@ macro_rules! export_fmi2 {
         #[allow(non_snake_case, clippy::missing_safety_doc)]
         mod fmi2_exports {
             use super::*;
-            use $crate::calls;
             use $crate::exports as body;
             use $crate::fmi_sys::fmi2::*;
             type S = $slave;
@@ -75,18 +78,18 @@ macro_rules! export_fmi2 {
                 fn fmi2DeSerializeFMUstate(c: fmi2Component, serializedState: *const fmi2Byte, size: usize, FMUstate: *mut fmi2FMUstate) -> fmi2Status => fmi2DeSerializeFMUstateTYPE;
             );
 
-            $crate::export_fmi2!(@never S;
-                fn fmi2EnterEventMode() = ENTER_EVENT_MODE => fmi2EnterEventModeTYPE;
-                fn fmi2NewDiscreteStates(info: *mut fmi2EventInfo) = NEW_DISCRETE_STATES => fmi2NewDiscreteStatesTYPE;
-                fn fmi2EnterContinuousTimeMode() = ENTER_CONTINUOUS_TIME_MODE => fmi2EnterContinuousTimeModeTYPE;
-                fn fmi2CompletedIntegratorStep(no_set_prior: fmi2Boolean, enter_event: *mut fmi2Boolean, terminate: *mut fmi2Boolean) = COMPLETED_INTEGRATOR_STEP => fmi2CompletedIntegratorStepTYPE;
-                fn fmi2SetTime(time: fmi2Real) = SET_TIME => fmi2SetTimeTYPE;
-                fn fmi2SetContinuousStates(x: *const fmi2Real, nx: usize) = SET_CONTINUOUS_STATES => fmi2SetContinuousStatesTYPE;
-                fn fmi2GetDerivatives(derivatives: *mut fmi2Real, nx: usize) = GET_DERIVATIVES => fmi2GetDerivativesTYPE;
-                fn fmi2GetEventIndicators(indicators: *mut fmi2Real, ni: usize) = GET_EVENT_INDICATORS => fmi2GetEventIndicatorsTYPE;
-                fn fmi2GetContinuousStates(x: *mut fmi2Real, nx: usize) = GET_CONTINUOUS_STATES => fmi2GetContinuousStatesTYPE;
-                fn fmi2GetNominalsOfContinuousStates(nominals: *mut fmi2Real, nx: usize) = GET_NOMINALS_OF_CONTINUOUS_STATES => fmi2GetNominalsOfContinuousStatesTYPE;
-                fn fmi2GetDirectionalDerivative(unknowns: *const fmi2ValueReference, n_unknown: usize, knowns: *const fmi2ValueReference, n_known: usize, dv_known: *const fmi2Real, dv_unknown: *mut fmi2Real) = GET_DIRECTIONAL_DERIVATIVE => fmi2GetDirectionalDerivativeTYPE;
+            $crate::export_fmi2!(@fns S;
+                fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status => fmi2EnterEventModeTYPE;
+                fn fmi2NewDiscreteStates(c: fmi2Component, info: *mut fmi2EventInfo) -> fmi2Status => fmi2NewDiscreteStatesTYPE;
+                fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status => fmi2EnterContinuousTimeModeTYPE;
+                fn fmi2CompletedIntegratorStep(c: fmi2Component, noSetFMUStatePriorToCurrentPoint: fmi2Boolean, enterEventMode: *mut fmi2Boolean, terminateSimulation: *mut fmi2Boolean) -> fmi2Status => fmi2CompletedIntegratorStepTYPE;
+                fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status => fmi2SetTimeTYPE;
+                fn fmi2SetContinuousStates(c: fmi2Component, x: *const fmi2Real, nx: usize) -> fmi2Status => fmi2SetContinuousStatesTYPE;
+                fn fmi2GetDerivatives(c: fmi2Component, derivatives: *mut fmi2Real, nx: usize) -> fmi2Status => fmi2GetDerivativesTYPE;
+                fn fmi2GetEventIndicators(c: fmi2Component, eventIndicators: *mut fmi2Real, ni: usize) -> fmi2Status => fmi2GetEventIndicatorsTYPE;
+                fn fmi2GetContinuousStates(c: fmi2Component, x: *mut fmi2Real, nx: usize) -> fmi2Status => fmi2GetContinuousStatesTYPE;
+                fn fmi2GetNominalsOfContinuousStates(c: fmi2Component, x_nominal: *mut fmi2Real, nx: usize) -> fmi2Status => fmi2GetNominalsOfContinuousStatesTYPE;
+                fn fmi2GetDirectionalDerivative(c: fmi2Component, vUnknown_ref: *const fmi2ValueReference, nUnknown: usize, vKnown_ref: *const fmi2ValueReference, nKnown: usize, dvKnown: *const fmi2Real, dvUnknown: *mut fmi2Real) -> fmi2Status => fmi2GetDirectionalDerivativeTYPE;
             );
         }
     };
@@ -98,17 +101,6 @@ macro_rules! export_fmi2 {
             pub unsafe extern "C" fn $name( $( $arg : $ty ),* ) -> $ret {
                 // SAFETY: the host's arguments, checked by the body before use.
                 unsafe { body::$name::<$s>( $( $arg ),* ) }
-            }
-            const _: $check = Some($name);
-        )*
-    };
-    (@never $s:ident; $( fn $name:ident ( $( $arg:ident : $ty:ty ),* ) = $call:ident => $check:ident ; )*) => {
-        $(
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn $name(c: fmi2Component $(, $arg: $ty)*) -> fmi2Status {
-                $( let _ = $arg; )*
-                // SAFETY: only the component pointer is used, recognised by its mark.
-                unsafe { body::not_offered::<$s>(c, &calls::$call) }
             }
             const _: $check = Some($name);
         )*

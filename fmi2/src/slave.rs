@@ -3,6 +3,7 @@
 //! variables and its model; it never sees a host pointer, a phase mask or the logger.
 
 use crate::calls::Phase;
+use crate::continuous::Continuous;
 use crate::description::{Table, VarType};
 use crate::frame::{Experiment, Reader};
 use crate::status::{Refusal, Reply};
@@ -15,9 +16,10 @@ pub struct Context {
     pub time: f64,
 }
 
-/// One FMU's model behind the FMI 2.0 Co-Simulation interface. Every method leaves the slave
-/// as it was when it refuses.
-pub trait Slave: Sized {
+/// One FMU's model behind the FMI 2.0 Co-Simulation interface, and through [`Continuous`] (whose
+/// defaults refuse it) behind Model Exchange. Every method leaves the slave as it was when it
+/// refuses.
+pub trait Slave: Continuous {
     /// The model description (variables, value references, GUID, log categories).
     const TABLE: &'static Table;
     /// Marks this FMU's instances and states in memory (a pointer of another kind is refused).
@@ -36,6 +38,10 @@ pub trait Slave: Sized {
 
     /// fmi2ExitInitializationMode: build the simulation from the parameters; warnings to log.
     fn initialise(&mut self, context: &Context) -> Result<Vec<String>, Refusal>;
+
+    /// Undo [`Slave::initialise`] (the parameters stay): a Model Exchange instance whose
+    /// parameters choose a model not offered there stays in initialisation mode.
+    fn uninitialise(&mut self);
 
     /// fmi2DoStep from `t` by `h` (both finite, `h` > 0, `t` the instance's time): all or
     /// nothing. `Ok(true)`: carried out, with a notice for the host ([`Slave::notice`]). (A

@@ -35,7 +35,9 @@ impl Tld {
                 None => self.output_before_init(context, which),
             },
             Source::Derived => self.derived(context, r, function),
-            Source::NoValue(_) => Err(TABLE.no_value(r, function)),
+            Source::NoValue(_) => self
+                .derivative_value(context, r)
+                .unwrap_or_else(|| Err(TABLE.no_value(r, function))),
             Source::WrongType(index) => Err(fmi2_slave::description::wrong_type(
                 r,
                 &VARIABLES[index],

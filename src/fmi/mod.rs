@@ -6,6 +6,7 @@
 mod access;
 #[cfg(test)]
 mod generated_tests;
+mod me;
 mod params;
 mod slave;
 mod snapshot;

@@ -170,7 +170,9 @@ pub const fn source(vr: u32, ty: VarType) -> Source {
         return Source::WrongType(index);
     }
     match var.causality {
-        Causality::Parameter | Causality::Input | Causality::Local => Source::Stored(index),
+        Causality::Parameter | Causality::Input => Source::Stored(index),
+        // The locals are Model Exchange's state derivatives, computed (fmi/me.rs).
+        Causality::Local => Source::NoValue(index),
         Causality::CalculatedParameter => Source::Derived,
         Causality::Output => match output_of(vr) {
             Some(which) => Source::Output(which),

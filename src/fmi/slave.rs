@@ -94,6 +94,10 @@ impl Slave for Tld {
         Ok(warnings)
     }
 
+    fn uninitialise(&mut self) {
+        self.sim = None;
+    }
+
     #[inline]
     fn step(&mut self, _: &Context, t: f64, h: f64) -> Result<bool, Refusal> {
         debug_assert!(finite(t) && h > 0.0);

@@ -20,7 +20,6 @@
 //! All numbers little-endian.
 
 use fmi2_slave::Context;
-use fmi2_slave::calls::Phase;
 use fmi2_slave::frame::{Reader, put_f64, put_f64_list};
 
 use super::params::{Configuration, Values};
@@ -51,7 +50,7 @@ impl Tld {
             return Err("non-finite input derivatives".into());
         }
         let values = Values::from_saved(&saved_values)?;
-        let initialised = matches!(context.phase, Phase::StepComplete | Phase::Terminated);
+        let initialised = context.phase.initialised();
         let sim = if initialised {
             let configuration = Configuration {
                 values: &values,

@@ -329,5 +329,7 @@ fn per_step(model: &AnyModel) -> [f64; 3] {
     [model.force(), x, v]
 }
 
+mod continuous;
+
 #[cfg(test)]
 mod tests;

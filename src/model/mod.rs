@@ -4,6 +4,7 @@
 //! state's frame). Knows no FMI: parameters arrive through [`Parameters`] by value reference.
 
 mod common;
+pub mod continuous;
 mod damper;
 mod parameters;
 mod rates;

@@ -97,7 +97,17 @@ pub struct Instance {
 }
 
 impl Instance {
+    /// A Co-Simulation instance.
     pub fn new(name: &str) -> Self {
+        Self::of_type(name, fmi2Type_fmi2CoSimulation)
+    }
+
+    /// A Model Exchange instance.
+    pub fn model_exchange(name: &str) -> Self {
+        Self::of_type(name, fmi2Type_fmi2ModelExchange)
+    }
+
+    pub fn of_type(name: &str, fmu_type: fmi2Type) -> Self {
         let lib = library();
         let callbacks = callbacks();
         let cname = CString::new(name).expect("name");
@@ -106,7 +116,7 @@ impl Instance {
         let c = unsafe {
             lib.fmi2Instantiate(
                 cname.as_ptr(),
-                fmi2Type_fmi2CoSimulation,
+                fmu_type,
                 guid.as_ptr(),
                 std::ptr::null(),
                 &*callbacks,
@@ -176,6 +186,109 @@ impl Instance {
             self.time += h;
         }
         s
+    }
+
+    // Model Exchange.
+    pub fn set_time(&self, t: f64) -> fmi2Status {
+        unsafe { self.lib.fmi2SetTime(self.c, t) }
+    }
+    pub fn enter_event_mode(&self) -> fmi2Status {
+        unsafe { self.lib.fmi2EnterEventMode(self.c) }
+    }
+    pub fn enter_continuous_time_mode(&self) -> fmi2Status {
+        unsafe { self.lib.fmi2EnterContinuousTimeMode(self.c) }
+    }
+    /// fmi2NewDiscreteStates: the status and the event info.
+    pub fn new_discrete_states(&self) -> (fmi2Status, fmi2EventInfo) {
+        let mut info = fmi2EventInfo {
+            newDiscreteStatesNeeded: 1,
+            terminateSimulation: 1,
+            nominalsOfContinuousStatesChanged: 1,
+            valuesOfContinuousStatesChanged: 1,
+            nextEventTimeDefined: 1,
+            nextEventTime: -1.0,
+        };
+        let s = unsafe { self.lib.fmi2NewDiscreteStates(self.c, &mut info) };
+        (s, info)
+    }
+    /// fmi2CompletedIntegratorStep: the status and (enterEventMode, terminateSimulation).
+    pub fn completed_integrator_step(&self) -> (fmi2Status, (i32, i32)) {
+        let (mut enter, mut terminate) = (-1, -1);
+        let s = unsafe {
+            self.lib
+                .fmi2CompletedIntegratorStep(self.c, 1, &mut enter, &mut terminate)
+        };
+        (s, (enter, terminate))
+    }
+    pub fn set_states(&self, x: &[f64]) -> fmi2Status {
+        unsafe {
+            self.lib
+                .fmi2SetContinuousStates(self.c, x.as_ptr(), x.len())
+        }
+    }
+    /// One of fmi2GetContinuousStates, fmi2GetDerivatives, fmi2GetNominalsOfContinuousStates,
+    /// fmi2GetEventIndicators into an array of `n`: the status and the values (NaN if untouched).
+    pub fn get_array(
+        &self,
+        f: unsafe fn(&Fmi2Binding, fmi2Component, *mut f64, usize) -> fmi2Status,
+        n: usize,
+    ) -> (fmi2Status, Vec<f64>) {
+        let mut out = vec![f64::NAN; n];
+        let s = unsafe { f(self.lib, self.c, out.as_mut_ptr(), n) };
+        (s, out)
+    }
+    pub fn states(&self, n: usize) -> (fmi2Status, Vec<f64>) {
+        self.get_array(
+            |l, c, p, n| unsafe { l.fmi2GetContinuousStates(c, p, n) },
+            n,
+        )
+    }
+    pub fn derivatives(&self, n: usize) -> (fmi2Status, Vec<f64>) {
+        self.get_array(|l, c, p, n| unsafe { l.fmi2GetDerivatives(c, p, n) }, n)
+    }
+    pub fn nominals(&self, n: usize) -> (fmi2Status, Vec<f64>) {
+        self.get_array(
+            |l, c, p, n| unsafe { l.fmi2GetNominalsOfContinuousStates(c, p, n) },
+            n,
+        )
+    }
+    pub fn event_indicators(&self, n: usize) -> (fmi2Status, Vec<f64>) {
+        self.get_array(|l, c, p, n| unsafe { l.fmi2GetEventIndicators(c, p, n) }, n)
+    }
+
+    /// Integrate the states over [t0, t1] by classical RK4 in `steps` steps, as an ME host
+    /// does: fmi2SetTime, fmi2SetContinuousStates, fmi2GetDerivatives for each stage, then
+    /// fmi2CompletedIntegratorStep; `input(t)` is called before each evaluation (set inputs).
+    pub fn rk4(&self, n: usize, t0: f64, t1: f64, steps: usize, input: impl Fn(&Self, f64)) {
+        let h = (t1 - t0) / steps as f64;
+        let (s, mut x) = self.states(n);
+        assert_eq!(s, OK, "{:?}", self.logs());
+        let f = |t: f64, x: &[f64]| {
+            assert_eq!(self.set_time(t), OK);
+            input(self, t);
+            assert_eq!(self.set_states(x), OK, "{:?}", self.logs());
+            let (s, d) = self.derivatives(n);
+            assert_eq!(s, OK, "{:?}", self.logs());
+            d
+        };
+        let axpy = |x: &[f64], k: &[f64], a: f64| -> Vec<f64> {
+            x.iter().zip(k).map(|(x, k)| x + a * k).collect()
+        };
+        for i in 0..steps {
+            let t = t0 + i as f64 * h;
+            let k1 = f(t, &x);
+            let k2 = f(t + h / 2.0, &axpy(&x, &k1, h / 2.0));
+            let k3 = f(t + h / 2.0, &axpy(&x, &k2, h / 2.0));
+            let k4 = f(t + h, &axpy(&x, &k3, h));
+            for j in 0..n {
+                x[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+            }
+            assert_eq!(self.set_time(t + h), OK);
+            input(self, t + h);
+            assert_eq!(self.set_states(&x), OK);
+            let (s, (event, terminate)) = self.completed_integrator_step();
+            assert_eq!((s, event, terminate), (OK, 0, 0), "{:?}", self.logs());
+        }
     }
 
     /// The serialised bytes of the instance's current FMU state (got, serialised and freed).

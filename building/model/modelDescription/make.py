@@ -70,6 +70,34 @@ ground_amp = add("ground.amplitude", 6, ty="Real", unit="m", start=0, min=-1000,
 ground_w = add("ground.omega", 7, ty="Real", unit="rad/s", start=5.6389, min=0, max=10000,
                description="omega, circular frequency of the built-in ground motion (default 5.6389: the "
                            "default one-storey building's own frequency)", **P)
+# Added for Model Exchange (indices above unchanged): the continuous states z = [u, u', x_g, v_g,
+# h, v_h] of the first-order system, padded to N storeys (the states of storeys above
+# `storeys` stay 0), and their derivatives.
+L = dict(causality="local", variability="continuous")
+floor_v = [add(f"floor[{i}].v", 600 + i - 1, ty="Real", unit="m/s", start=0,
+               description=f"velocity of floor {i} relative to the ground (a continuous state)", initial="exact", **L)
+           for i in range(1, N + 1)]
+ground_x = add("ground.x", 50, ty="Real", unit="m", start=0, initial="exact",
+               description="the ground's displacement (ground.a integrated from rest, plus the built-in motion's; a continuous state)", **L)
+ground_v = add("ground.v", 51, ty="Real", unit="m/s", initial="calculated",
+               description="the ground's velocity (starts at ground.amplitude ground.omega; a continuous state)", **L)
+ground_h = add("ground.motion.x", 52, ty="Real", unit="m", start=0, initial="exact",
+               description="the built-in harmonic ground motion's displacement A sin(omega t) (a continuous state)", **L)
+ground_hv = add("ground.motion.v", 53, ty="Real", unit="m/s", initial="calculated",
+                description="the built-in harmonic ground motion's velocity A omega cos(omega t) (a continuous state)", **L)
+states = floor_x + floor_v + [ground_x, ground_v, ground_h, ground_hv]
+D = dict(causality="local", variability="continuous", initial="calculated")
+ders = []
+for i in range(1, N + 1):
+    ders.append(add(f"der(floor[{i}].x)", 700 + i - 1, ty="Real", unit="m/s", derivative=floor_x[i - 1],
+                    description=f"time derivative of floor[{i}].x", **D))
+for i in range(1, N + 1):
+    ders.append(add(f"der(floor[{i}].v)", 800 + i - 1, ty="Real", unit="m/s2", derivative=floor_v[i - 1],
+                    description=f"time derivative of floor[{i}].v", **D))
+for k, (name, unit) in enumerate([("ground.x", "m/s"), ("ground.v", "m/s2"), ("ground.motion.x", "m/s"),
+                                   ("ground.motion.v", "m/s2")]):
+    ders.append(add(f"der({name})", 54 + k, ty="Real", unit=unit, derivative=states[2 * N + k],
+                    description=f"time derivative of {name}", **D))
 
 
 def deps(xs):
@@ -89,6 +117,9 @@ for i, k in enumerate(floor_a):
     outputs.append((k, [tld_force, floor_f[i]], [tld_force, floor_f[i]] + structure))
 outputs.sort()
 initial = sorted(outputs + [(k, None, everything) for k in [w1, w2, alpha, beta]])
+initial += [(ground_v, None, [ground_amp, ground_w]), (ground_hv, None, [ground_amp, ground_w])]
+initial += [(k, None, everything + [ground_a, ground_amp, ground_w] + forces) for k in ders]
+initial.sort()
 
 
 def attr_text(attrs):
@@ -117,6 +148,16 @@ lines = ['<?xml version="1.0" encoding="UTF-8"?>',
     canInterpolateInputs="true"
     maxOutputDerivativeOrder="1"
     canRunAsynchronuously="false"
+    canBeInstantiatedOnlyOncePerProcess="false"
+    canNotUseMemoryManagementFunctions="true"
+    canGetAndSetFMUstate="true"
+    canSerializeFMUstate="true"
+    providesDirectionalDerivative="false"/>
+
+  <ModelExchange
+    modelIdentifier="Building"
+    needsExecutionTool="false"
+    completedIntegratorStepNotNeeded="true"
     canBeInstantiatedOnlyOncePerProcess="false"
     canNotUseMemoryManagementFunctions="true"
     canGetAndSetFMUstate="true"
@@ -153,7 +194,11 @@ for k, (name, vr, causality, variability, initial_, ty, attrs, description) in e
 lines.append("  </ModelVariables>\n\n  <ModelStructure>\n    <Outputs>")
 for k, d, _ in outputs:
     lines.append(f'      <Unknown index="{k}" dependencies="{deps(d)}"/>')
-lines.append("    </Outputs>\n    <InitialUnknowns>")
+lines.append("    </Outputs>\n    <Derivatives>")
+inputs = [ground_a] + forces
+for k in ders:
+    lines.append(f'      <Unknown index="{k}" dependencies="{deps(states + inputs)}"/>')
+lines.append("    </Derivatives>\n    <InitialUnknowns>")
 for k, _, d in initial:
     lines.append(f'      <Unknown index="{k}" dependencies="{deps(d)}"/>')
 lines.append("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n")

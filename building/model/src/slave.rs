@@ -3,7 +3,6 @@
 //! its state. The shared layer has checked the call's phase and the host's pointers before any
 //! method here runs; every refusal leaves the slave as it was.
 
-use fmi2_slave::calls::Phase;
 use fmi2_slave::description::Table;
 use fmi2_slave::frame::{Reader, put_f64_list};
 use fmi2_slave::{Context, Refusal, Reply, Slave, Status, refuse};
@@ -51,6 +50,8 @@ pub struct Building {
     derivatives: Vec<[f64; ORDERS]>,
     sim: Option<Simulation>,
 }
+
+mod me;
 
 /// The value of `vr` in `values` (NaN if it names no variable).
 fn value(values: &[f64], r: u32) -> f64 {
@@ -236,7 +237,9 @@ impl Building {
             Causality::CalculatedParameter => {
                 Self::derived(&*self.simulation()?, r).ok_or_else(|| TABLE.no_value(r, function))
             }
-            Causality::Local => Err(TABLE.no_value(r, function)),
+            Causality::Local => self
+                .local(r)
+                .unwrap_or_else(|| Err(TABLE.no_value(r, function))),
         }
     }
 }
@@ -262,6 +265,10 @@ impl Slave for Building {
     fn initialise(&mut self, _: &Context) -> Result<Vec<String>, Refusal> {
         self.sim = Some(configure(&self.values)?);
         Ok(Vec::new())
+    }
+
+    fn uninitialise(&mut self) {
+        self.sim = None;
     }
 
     fn step(&mut self, _: &Context, t: f64, h: f64) -> Result<bool, Refusal> {
@@ -354,23 +361,46 @@ impl Slave for Building {
     /// Values of all variables | input derivatives (orders 1, 2 of every variable) | the state
     /// z = [u, u', x_g, v_g, h, v_h] (empty before initialisation).
     fn save(&self, out: &mut Vec<u8>) {
-        put_f64_list(out, &self.values);
-        let flat: Vec<f64> = self.derivatives.iter().flatten().copied().collect();
+        // Model Exchange's locals (states and derivatives) are the simulation's, not values:
+        // the saved values are those of the other variables, as before they were added.
+        let kept = |k: &usize| VARIABLES[*k].causality != Causality::Local;
+        let values: Vec<f64> = (0..VARIABLES.len())
+            .filter(kept)
+            .map(|k| self.values[k])
+            .collect();
+        put_f64_list(out, &values);
+        let flat: Vec<f64> = (0..VARIABLES.len())
+            .filter(kept)
+            .flat_map(|k| self.derivatives[k])
+            .collect();
         put_f64_list(out, &flat);
         put_f64_list(out, self.sim.as_ref().map_or(&[][..], |s| &s.z));
     }
 
     fn load(context: &Context, _: bool, part: &mut Reader) -> Result<Self, String> {
-        let values = part.f64_list()?;
-        let flat = part.f64_list()?;
+        let saved = part.f64_list()?;
+        let saved_flat = part.f64_list()?;
         let z = part.f64_list()?;
-        if values.len() != VARIABLES.len() || flat.len() != ORDERS * VARIABLES.len() {
+        let kept: Vec<usize> = (0..VARIABLES.len())
+            .filter(|k| VARIABLES[*k].causality != Causality::Local)
+            .collect();
+        if saved.len() != kept.len() || saved_flat.len() != ORDERS * kept.len() {
             return Err(format!(
                 "{} values and {} derivatives for {} variables",
-                values.len(),
-                flat.len(),
-                VARIABLES.len()
+                saved.len(),
+                saved_flat.len(),
+                kept.len()
             ));
+        }
+        let mut values: Vec<f64> = VARIABLES
+            .iter()
+            .map(|v| v.start.unwrap_or(f64::NAN))
+            .collect();
+        let mut flat = vec![0.0; ORDERS * VARIABLES.len()];
+        for (j, &k) in kept.iter().enumerate() {
+            values[k] = saved[j];
+            flat[ORDERS * k..ORDERS * (k + 1)]
+                .copy_from_slice(&saved_flat[ORDERS * j..ORDERS * (j + 1)]);
         }
         for (var, &v) in VARIABLES.iter().zip(&values) {
             if var.start.is_some()
@@ -383,7 +413,7 @@ impl Slave for Building {
             return Err("non-finite input derivatives".into());
         }
         let derivatives = flat.chunks(ORDERS).map(|c| [c[0], c[1]]).collect();
-        let initialised = matches!(context.phase, Phase::StepComplete | Phase::Terminated);
+        let initialised = context.phase.initialised();
         let sim = if initialised {
             let mut s = configure(&values).map_err(|r| *r.message)?;
             if z.len() != s.z.len() || !z.iter().all(|x| x.is_finite()) {

@@ -9,7 +9,7 @@ use fmi_sys::fmi2::*;
 use super::{guard, host_ref, host_slice, host_text};
 use crate::calls::{self, Call};
 use crate::description::log_category;
-use crate::instance::Instance;
+use crate::instance::{Instance, Kind};
 use crate::logger::Logger;
 use crate::slave::Slave;
 use crate::status::{Refusal, Status, refuse};
@@ -57,15 +57,20 @@ pub unsafe fn fmi2Instantiate<S: Slave>(
             report(model, "fmi2Instantiate: instanceName is NULL");
             return std::ptr::null_mut();
         };
-        if fmuType != fmi2Type_fmi2CoSimulation {
-            report(
-                &name,
-                &format!(
-                    "fmi2Instantiate: {model}.fmu supports Co-Simulation only (fmuType must be fmi2CoSimulation)"
-                ),
-            );
-            return std::ptr::null_mut();
-        }
+        #[allow(non_upper_case_globals)]
+        let kind = match fmuType {
+            fmi2Type_fmi2CoSimulation => Kind::CoSimulation,
+            fmi2Type_fmi2ModelExchange => Kind::ModelExchange,
+            other => {
+                report(
+                    &name,
+                    &format!(
+                        "fmi2Instantiate: fmuType {other} is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)"
+                    ),
+                );
+                return std::ptr::null_mut();
+            }
+        };
         // SAFETY: as above.
         match unsafe { host_text(fmuGUID) } {
             Some(guid) if guid == S::TABLE.guid => {}
@@ -81,7 +86,13 @@ pub unsafe fn fmi2Instantiate<S: Slave>(
             }
         }
         let c_name = CString::new(name.replace('\0', " ")).unwrap_or_default();
-        let instance = Box::new(Instance::<S>::new(c_name, logger, loggingOn != 0));
+        let instance = Box::new(Instance::<S>::new(c_name, logger, loggingOn != 0, kind));
+        if kind == Kind::ModelExchange
+            && loggingOn != 0
+            && let Some(note) = S::MODEL_EXCHANGE_NOTE
+        {
+            instance.log(Status::Ok, log_category::LOG_CALLS, note);
+        }
         Box::into_raw(instance) as fmi2Component
     });
     made.unwrap_or(std::ptr::null_mut())
@@ -275,11 +286,4 @@ pub unsafe fn fmi2GetStringStatus<S: Slave>(
             format!("fmi2GetStringStatus: status kind {s}: nothing is pending"),
         ))
     })
-}
-
-/// A function this FMU exports so that every host resolves its symbols, but never carries out:
-/// the table gives it no phase, and the guard refuses it with the table's reason.
-#[inline(always)]
-pub unsafe fn not_offered<S: Slave>(c: fmi2Component, call: &'static Call) -> fmi2Status {
-    guard::<S>(c, call, |_| Ok(Status::Ok))
 }

@@ -7,10 +7,12 @@
 #![allow(clippy::missing_safety_doc)]
 
 mod lifecycle;
+mod me;
 mod state;
 mod values;
 
 pub use lifecycle::*;
+pub use me::*;
 pub use state::*;
 pub use values::*;
 

@@ -5,7 +5,6 @@ use fmi_sys::fmi2::*;
 
 use super::{guard, host_ref, host_slice, host_slice_mut};
 use crate::calls::{self, Call};
-use crate::instance::Instance;
 use crate::slave::Slave;
 use crate::status::{Refusal, Status, refuse};
 
@@ -147,7 +146,7 @@ pub unsafe fn fmi2DeSerializeFMUstate<S: Slave>(
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     const CALL: &Call = &calls::DE_SERIALIZE_FMU_STATE;
-    guard::<S>(c, CALL, |_| {
+    guard::<S>(c, CALL, |inst| {
         // SAFETY: host buffer of `size` bytes and host output scalar.
         let (bytes, out) = unsafe {
             (
@@ -155,7 +154,7 @@ pub unsafe fn fmi2DeSerializeFMUstate<S: Slave>(
                 host_ref(FMUstate, CALL, "FMUstate")?,
             )
         };
-        Instance::<S>::check_saved(bytes)
+        inst.check_saved(bytes)
             .map_err(|r| refuse(format!("fmi2DeSerializeFMUstate: {}", r.message)))?;
         // A host may hand back one of our states for reuse (fmpy does); anything else in the
         // slot is not ours to free, and a new state is made.

@@ -1,0 +1,165 @@
+//! Building.fmu in Model Exchange: the first-order system z' = A z + B p of the exact step
+//! (structure.rs), its state z = [u, u', x_g, v_g, h, v_h] padded to MAX_STOREYS storeys (the
+//! model description declares a fixed number of states; those of storeys above `storeys` stay
+//! 0), and its derivatives. The same A and B the exact propagator exponentiates: no equation is
+//! written twice.
+
+use fmi2_slave::{Context, Continuous, Refusal, Reply, Status, refuse};
+use nalgebra::DVector;
+
+use super::{Building, Simulation};
+use crate::description::vr;
+use crate::structure::MAX_STOREYS;
+
+/// Declared states: 2 MAX_STOREYS floor states and the ground's four.
+pub const STATES: usize = 2 * MAX_STOREYS + 4;
+
+/// Position in the padded vector of entry `k` of the state z of an `n`-storey building.
+fn padded(k: usize, n: usize) -> usize {
+    if k < n {
+        k
+    } else if k < 2 * n {
+        MAX_STOREYS + (k - n)
+    } else {
+        2 * MAX_STOREYS + (k - 2 * n)
+    }
+}
+
+impl Building {
+    fn running(&self, function: &str) -> Result<&Simulation, Refusal> {
+        self.sim
+            .as_ref()
+            .ok_or_else(|| refuse(format!("{function}: no simulation (not initialised)")))
+    }
+
+    /// dz/dt now, with the inputs the host set.
+    fn rates(&self, s: &Simulation) -> DVector<f64> {
+        let p = DVector::from_vec(self.channels(s, 0));
+        &s.a * DVector::from_column_slice(&s.z) + &s.b * p
+    }
+
+    /// The value of a state or derivative variable (Model Exchange's locals), if `r` is one.
+    pub(super) fn local(&self, r: u32) -> Option<Result<f64, Refusal>> {
+        let m = MAX_STOREYS;
+        let within = |first: u32, len: usize| {
+            (first..first + len as u32)
+                .contains(&r)
+                .then(|| (r - first) as usize)
+        };
+        let (state, p) = if let Some(k) = within(vr::FLOOR_1__V, m) {
+            (true, m + k)
+        } else if let Some(k) = within(vr::GROUND_X, 4) {
+            (true, 2 * m + k)
+        } else if let Some(k) = within(vr::DER_FLOOR_1__X_, m) {
+            (false, k)
+        } else if let Some(k) = within(vr::DER_FLOOR_1__V_, m) {
+            (false, m + k)
+        } else {
+            (false, 2 * m + within(vr::DER_GROUND_X_, 4)?)
+        };
+        let context = Context {
+            phase: fmi2_slave::calls::Phase::EventMode,
+            experiment: Default::default(),
+            time: 0.0,
+        };
+        let mut out = [0.0; STATES];
+        let done = if state {
+            self.states(&mut out)
+        } else {
+            self.derivatives(&context, &mut out)
+        };
+        Some(done.map(|_| out[p]))
+    }
+}
+
+impl Continuous for Building {
+    const STATES: usize = STATES;
+    const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
+        "Model Exchange: 44 continuous states, floor[i].x and floor[i].v for 20 storeys (those \
+         above 'storeys' stay 0), ground.x, ground.v and the built-in motion's ground.motion.x, \
+         ground.motion.v; see docs/MODEL_EXCHANGE.md",
+    );
+
+    fn offers_model_exchange(&self) -> Result<(), String> {
+        self.running("fmi2ExitInitializationMode")
+            .map(|_| ())
+            .map_err(|r| *r.message)
+    }
+
+    fn states(&self, x: &mut [f64]) -> Reply {
+        let s = self.running("fmi2GetContinuousStates")?;
+        x.fill(0.0);
+        for (k, z) in s.z.iter().enumerate() {
+            x[padded(k, s.building.n)] = *z;
+        }
+        Ok(Status::Ok)
+    }
+
+    fn set_states(&mut self, _: &Context, x: &[f64]) -> Reply {
+        let s = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| refuse("fmi2SetContinuousStates: no simulation (not initialised)"))?;
+        let n = s.building.n;
+        for k in 0..s.z.len() {
+            s.z[k] = x[padded(k, n)];
+        }
+        Ok(Status::Ok)
+    }
+
+    fn derivatives(&self, context: &Context, dx: &mut [f64]) -> Reply {
+        let s = self.running("fmi2GetDerivatives")?;
+        let rates = self.rates(s);
+        if let Some(k) = rates.iter().position(|v| !v.is_finite()) {
+            return Err(refuse(format!(
+                "fmi2GetDerivatives at t = {}: derivative {k} is not finite (inputs too large?)",
+                context.time
+            )));
+        }
+        dx.fill(0.0);
+        for (k, r) in rates.iter().enumerate() {
+            dx[padded(k, s.building.n)] = *r;
+        }
+        Ok(Status::Ok)
+    }
+
+    /// Floors: the static drift of the first storey under 1 g of its own mass, and its velocity
+    /// at the first mode's frequency; the ground's: 1 m, 1 m/s.
+    fn nominals(&self, out: &mut [f64]) -> Reply {
+        let s = self.running("fmi2GetNominalsOfContinuousStates")?;
+        let b = &s.building;
+        let x = (b.mass.sum() * 9.81 / b.storeys[0]).clamp(1e-6, 1.0);
+        let v = (x * b.omega[0]).clamp(1e-6, 1.0);
+        out[..MAX_STOREYS].fill(x);
+        out[MAX_STOREYS..2 * MAX_STOREYS].fill(v);
+        out[2 * MAX_STOREYS..].fill(1.0);
+        Ok(Status::Ok)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn padding_keeps_each_block_in_its_place() {
+        let n = 3;
+        let got: Vec<usize> = (0..2 * n + 4).map(|k| padded(k, n)).collect();
+        let m = MAX_STOREYS;
+        assert_eq!(
+            got,
+            [
+                0,
+                1,
+                2,
+                m,
+                m + 1,
+                m + 2,
+                2 * m,
+                2 * m + 1,
+                2 * m + 2,
+                2 * m + 3
+            ]
+        );
+    }
+}

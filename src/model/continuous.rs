@@ -1,0 +1,148 @@
+//! Model Exchange, the models' side: which models a host's own solver can integrate, and their
+//! continuous states. The offered models are one oscillator of Eq 2.11 (Linear with one mode,
+//! Nonlinear, Auto), whose states are the sloshing mass's relative displacement and velocity
+//! and the two energy integrals, [x, v, energy.input, energy.dissipated]; their time
+//! derivatives are the exact output rates every model already provides ([`Model::rate`]), so
+//! no equation is written twice. Knows no FMI.
+//!
+//! Not offered, each with its reason: SloshingSlamming (its impacts are instants that change
+//! the velocity: state events with an event iteration, not yet written) and ShallowWater (its
+//! 2 x swe.cells states cannot be declared in an FMI 2.0 model description whose number of
+//! states is fixed, while swe.cells is a parameter). A Linear model of more than one mode
+//! would need more states than the model description declares.
+//!
+//! [`Model::rate`]: super::Model::rate
+
+use super::registry::AnyModel;
+use super::{Observable, Output};
+
+/// Numbers of continuous states: x, v, energy.input, energy.dissipated.
+pub const STATES: usize = 4;
+
+/// The outputs whose rates are the states' derivatives, in state order.
+pub const RATES: [Output; STATES] = [
+    Output::X,
+    Output::V,
+    Output::EnergyInput,
+    Output::EnergyDissipated,
+];
+
+/// The saved numbers of every offered model begin with the fundamental oscillator's state per
+/// unit sloshing mass: x, v, work in, dissipated (Linear's first mode, Nonlinear's and Auto's
+/// `y`); the tests check it for each.
+const OSCILLATOR: usize = 4;
+
+impl AnyModel {
+    /// Ok if the host's solver can integrate this model; Err: why not.
+    pub fn offers_model_exchange(&self) -> Result<(), String> {
+        match self {
+            AnyModel::Linear(_) if self.state_len() != OSCILLATOR + 3 => Err(format!(
+                "model = Linear with modes > 1: Model Exchange declares {STATES} continuous states \
+                 (one mode); use modes = 1, or Co-Simulation for more modes"
+            )),
+            AnyModel::Linear(_) | AnyModel::Nonlinear(_) | AnyModel::Auto(_) => Ok(()),
+            AnyModel::SloshingSlamming(_) => Err(
+                "model = SloshingSlamming is Co-Simulation only for now: its impacts need state \
+                 events (the gap to each wall as event indicator) that are not yet offered"
+                    .into(),
+            ),
+            AnyModel::ShallowWater(_) => Err(
+                "model = ShallowWater is Co-Simulation only: its 2 x swe.cells states cannot be \
+                 declared in an FMI 2.0 model description, where the number of states is fixed \
+                 and swe.cells is a parameter"
+                    .into(),
+            ),
+        }
+    }
+
+    /// The continuous states [x, v, work in, dissipated]; `initial_energy` is counted as input
+    /// (as the output energy.input does).
+    pub fn continuous_states(&self, initial_energy: f64) -> [f64; STATES] {
+        let (x, v) = self.sloshing();
+        [
+            x,
+            v,
+            initial_energy + self.observe(Observable::WorkIn),
+            self.observe(Observable::Dissipated),
+        ]
+    }
+
+    /// Take the continuous states `s` (as [`AnyModel::continuous_states`] gives them).
+    pub fn set_continuous_states(
+        &mut self,
+        s: &[f64; STATES],
+        initial_energy: f64,
+    ) -> Result<(), String> {
+        let mass = self.sloshing_mass();
+        let mut saved = Vec::with_capacity(self.state_len());
+        self.save(&mut saved);
+        saved[0] = s[0];
+        saved[1] = s[1];
+        saved[2] = (s[2] - initial_energy) / mass;
+        saved[3] = s[3] / mass;
+        self.load(&saved)
+    }
+
+    /// The states' time derivatives under base acceleration `a`.
+    pub fn continuous_derivatives(&self, a: f64) -> [f64; STATES] {
+        RATES.map(|which| self.rate(which, a, 0.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::description::{ModelKindItem, vr};
+    use crate::model::{Common, Start, StartValues};
+
+    fn model(item: ModelKindItem, modes: f64) -> AnyModel {
+        let p = StartValues::default().with(vr::MODES, modes);
+        let (common, _) = Common::read(&p).expect("start values are consistent");
+        let start = Start {
+            zeta: 0.02,
+            amplitude: 0.005,
+        };
+        AnyModel::configure(item, &p, &common, start).expect("configures")
+    }
+
+    /// Every offered model takes its continuous states back (so the saved layout they are
+    /// written into is the one its outputs read), and its derivatives are x' = v and the
+    /// energies' rates.
+    #[test]
+    fn offered_models_take_their_states_and_report_them() {
+        for item in [
+            ModelKindItem::Linear,
+            ModelKindItem::Nonlinear,
+            ModelKindItem::Auto,
+        ] {
+            let mut m = model(item, 1.0);
+            assert!(m.offers_model_exchange().is_ok(), "{item:?}");
+            let s = [0.0123, -0.045, 0.75, 0.125];
+            m.set_continuous_states(&s, 0.25).expect("takes them");
+            let back = m.continuous_states(0.25);
+            for k in 0..STATES {
+                assert!(
+                    (back[k] - s[k]).abs() <= 1e-14 * s[k].abs().max(1.0),
+                    "{item:?} state {k}: {} vs {}",
+                    back[k],
+                    s[k]
+                );
+            }
+            assert_eq!(m.sloshing(), (s[0], s[1]));
+            let d = m.continuous_derivatives(0.3);
+            assert_eq!(d[0], s[1], "{item:?}");
+            // The base's power on the sloshing mass, -m a v.
+            let want = -m.sloshing_mass() * 0.3 * s[1];
+            assert!((d[2] - want).abs() <= 1e-14 * want.abs(), "{item:?}");
+        }
+    }
+
+    /// The models that are not offered say why.
+    #[test]
+    fn models_not_offered_say_why() {
+        let why = |m: AnyModel| m.offers_model_exchange().err().unwrap_or_default();
+        assert!(why(model(ModelKindItem::Linear, 3.0)).contains("modes = 1"));
+        assert!(why(model(ModelKindItem::SloshingSlamming, 1.0)).contains("state events"));
+        assert!(why(model(ModelKindItem::ShallowWater, 1.0)).contains("swe.cells"));
+    }
+}
