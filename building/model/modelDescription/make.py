@@ -162,7 +162,7 @@ lines = ['<?xml version="1.0" encoding="UTF-8"?>',
     canNotUseMemoryManagementFunctions="true"
     canGetAndSetFMUstate="true"
     canSerializeFMUstate="true"
-    providesDirectionalDerivative="false"/>
+    providesDirectionalDerivative="true"/>
 
   <UnitDefinitions>
     <Unit name="1"/>

@@ -8,7 +8,7 @@ use fmi2_slave::{Context, Continuous, Refusal, Reply, Status, refuse};
 use nalgebra::DVector;
 
 use super::{Building, Simulation};
-use crate::description::vr;
+use crate::description::{Causality, TABLE, VARIABLES, VarType, index_of, vr};
 use crate::structure::MAX_STOREYS;
 
 /// Declared states: 2 MAX_STOREYS floor states and the ground's four.
@@ -36,6 +36,56 @@ impl Building {
     fn rates(&self, s: &Simulation) -> DVector<f64> {
         let p = DVector::from_vec(self.channels(s, 0));
         &s.a * DVector::from_column_slice(&s.z) + &s.b * p
+    }
+
+    /// The position in the padded state vector of the state variable `r`, if it is one.
+    fn state_position(r: u32) -> Option<usize> {
+        let m = MAX_STOREYS as u32;
+        let at = |first: u32, len: u32, base: usize| {
+            (first..first + len)
+                .contains(&r)
+                .then(|| base + (r - first) as usize)
+        };
+        at(vr::FLOOR_1__X, m, 0)
+            .or_else(|| at(vr::FLOOR_1__V, m, MAX_STOREYS))
+            .or_else(|| at(vr::GROUND_X, 4, 2 * MAX_STOREYS))
+    }
+
+    /// The system is linear and homogeneous in its states and inputs (every derivative and
+    /// output is a sum of terms each proportional to one of them): J d is the system evaluated
+    /// at states and inputs d, with the other states and inputs 0. Exact, no differencing.
+    fn linearised(&self, s: &Simulation, knowns: &[u32], dv: &[f64]) -> Result<Self, Refusal> {
+        let n = s.building.n;
+        let mut values = self.values.clone();
+        for (k, var) in VARIABLES.iter().enumerate() {
+            if var.causality == Causality::Input {
+                values[k] = 0.0;
+            }
+        }
+        let mut padded_z = [0.0; STATES];
+        for (&r, &d) in knowns.iter().zip(dv) {
+            if let Some(p) = Self::state_position(r) {
+                padded_z[p] += d;
+                continue;
+            }
+            match index_of(r).map(|k| (k, VARIABLES[k].causality)) {
+                Some((k, Causality::Input)) => values[k] += d,
+                _ => {
+                    return Err(refuse(format!(
+                        "fmi2GetDirectionalDerivative: value reference {r} is neither a continuous state nor an input"
+                    )));
+                }
+            }
+        }
+        let mut sim = s.clone();
+        for k in 0..sim.z.len() {
+            sim.z[k] = padded_z[padded(k, n)];
+        }
+        Ok(Building {
+            values,
+            derivatives: self.derivatives.clone(),
+            sim: Some(sim),
+        })
     }
 
     /// The value of a state or derivative variable (Model Exchange's locals), if `r` is one.
@@ -120,6 +170,33 @@ impl Continuous for Building {
         for (k, r) in rates.iter().enumerate() {
             dx[padded(k, s.building.n)] = *r;
         }
+        Ok(Status::Ok)
+    }
+
+    fn directional_derivative(
+        &self,
+        _: &Context,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Reply {
+        const F: &str = "fmi2GetDirectionalDerivative";
+        let s = self.running(F)?;
+        let linear = self.linearised(s, knowns, dv_known)?;
+        let mut out = Vec::with_capacity(unknowns.len());
+        for &r in unknowns {
+            let (_, var) = TABLE.variable(r, F)?;
+            let derivative = var.name.starts_with("der(");
+            if !(derivative || var.causality == Causality::Output) {
+                return Err(refuse(format!(
+                    "{F}: {} is neither a state derivative nor an output",
+                    var.name
+                )));
+            }
+            out.push(linear.value_of(r, VarType::Real, F)?);
+        }
+        dv_unknown.copy_from_slice(&out);
         Ok(Status::Ok)
     }
 

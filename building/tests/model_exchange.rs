@@ -1,0 +1,146 @@
+//! Building.fmu in Model Exchange through its C entry points: the padded state vector, its
+//! derivatives against the exact Co-Simulation step, and the directional derivatives of its
+//! linear system (exact) against differences of fmi2GetDerivatives and the outputs.
+
+mod host;
+
+use host::*;
+
+/// Declared continuous states: floor[i].x, floor[i].v for 20 storeys, ground.x, ground.v,
+/// ground.motion.x, ground.motion.v.
+const N: usize = 44;
+
+const THREE_STOREYS: [(u32, f64); 5] = [
+    (vr::STOREYS, 3.0),
+    (vr::TLD_MASS, 0.35),
+    (vr::STOREY_1__STIFFNESS + 2, 4000.0),
+    (vr::GROUND_AMPLITUDE, 0.004),
+    (vr::GROUND_OMEGA, 6.5),
+];
+
+fn running(name: &str) -> Instance {
+    let inst = Instance::model_exchange(name);
+    inst.initialise(&THREE_STOREYS);
+    let (s, info) = inst.new_discrete_states();
+    assert_eq!((s, info.newDiscreteStatesNeeded), (OK, 0));
+    assert_eq!(inst.enter_continuous_time_mode(), OK);
+    inst
+}
+
+/// A state with every floor of the three-storey building and the ground moving; the padding
+/// (storeys 4 to 20) at 0.
+fn some_state() -> Vec<f64> {
+    let mut x = vec![0.0; N];
+    for (k, v) in [0.01, -0.02, 0.015].iter().enumerate() {
+        x[k] = *v;
+        x[20 + k] = 3.0 * v + 0.1;
+    }
+    x[40..].copy_from_slice(&[0.002, -0.03, 0.001, 0.02]);
+    x
+}
+
+/// The ground starts with the built-in motion's velocity A w, the building at rest; the padded
+/// states of storeys above the building's stay 0 and have derivative 0.
+#[test]
+fn states_start_at_rest_and_the_padding_stays_zero() {
+    let inst = running("me-start");
+    let (s, x) = inst.states(N);
+    assert_eq!(s, OK);
+    let v0 = 0.004 * 6.5;
+    assert_eq!(x[41], v0);
+    assert_eq!(x[43], v0);
+    assert!(x[..40].iter().all(|v| *v == 0.0));
+    assert_eq!(inst.set_states(&some_state()), OK);
+    let (_, d) = inst.derivatives(N);
+    assert!(d[3..20].iter().chain(&d[23..40]).all(|v| *v == 0.0));
+    // x' = v for the floors and the ground, and the built-in motion is free: h'' = -w^2 h.
+    let x = some_state();
+    assert_eq!(d[..3], x[20..23]);
+    assert_eq!(d[40], x[41]);
+    assert!((d[43] + 6.5 * 6.5 * x[42]).abs() < 1e-15);
+    // The derivative variables read the same.
+    assert_eq!(inst.real(vr::DER_FLOOR_1__V_), d[20]);
+    assert_eq!(inst.real(vr::FLOOR_1__V + 1), x[21]);
+}
+
+/// J d for unit directions d: exactly the difference of fmi2GetDerivatives (and of the
+/// outputs) between the state (input) plus d and the state, the system being linear; and two
+/// entries written out: roof.x by floor[3].x is 1, tld.a by tld.force is 1/(floor mass +
+/// tld.mass).
+#[test]
+fn directional_derivatives_are_the_linear_system_s() {
+    let inst = running("me-jacobian");
+    let x = some_state();
+    assert_eq!(inst.set_states(&x), OK);
+    assert_eq!(inst.set_real(vr::TLD_FORCE, 2.0), OK);
+    let (_, d0) = inst.derivatives(N);
+    let der = |k: usize| -> u32 {
+        match k {
+            0..20 => vr::DER_FLOOR_1__X_ + k as u32,
+            20..40 => vr::DER_FLOOR_1__V_ + (k - 20) as u32,
+            _ => vr::DER_GROUND_X_ + (k - 40) as u32,
+        }
+    };
+    let state = |k: usize| -> u32 {
+        match k {
+            0..20 => vr::FLOOR_1__X + k as u32,
+            20..40 => vr::FLOOR_1__V + (k - 20) as u32,
+            _ => vr::GROUND_X + (k - 40) as u32,
+        }
+    };
+    let unknowns: Vec<u32> = (0..N).map(der).collect();
+    for k in [0, 2, 21, 22, 40, 41, 42, 43] {
+        let mut j = vec![f64::NAN; N];
+        let s = unsafe {
+            inst.lib.fmi2GetDirectionalDerivative(
+                inst.c,
+                unknowns.as_ptr(),
+                N,
+                &state(k),
+                1,
+                &1.0,
+                j.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, OK, "{:?}", inst.logs());
+        let mut moved = x.clone();
+        moved[k] += 1.0;
+        assert_eq!(inst.set_states(&moved), OK);
+        let (_, d1) = inst.derivatives(N);
+        assert_eq!(inst.set_states(&x), OK);
+        for i in 0..N {
+            let want = d1[i] - d0[i];
+            assert!(
+                (j[i] - want).abs() <= 1e-9 * want.abs().max(1.0),
+                "d der[{i}] / d state[{k}]: {} vs {want}",
+                j[i]
+            );
+        }
+    }
+    let one = |unknown: u32, known: u32| {
+        let mut v = f64::NAN;
+        let s = unsafe {
+            inst.lib
+                .fmi2GetDirectionalDerivative(inst.c, &unknown, 1, &known, 1, &1.0, &mut v)
+        };
+        assert_eq!(s, OK, "{:?}", inst.logs());
+        v
+    };
+    assert_eq!(one(vr::ROOF_X, vr::FLOOR_1__X + 2), 1.0);
+    assert_eq!(one(vr::ROOF_X, vr::FLOOR_1__X), 0.0);
+    let floor = 168.0 + 0.35;
+    assert!((one(vr::TLD_A, vr::TLD_FORCE) - 1.0 / floor).abs() < 1e-15);
+    // A known that is neither a state nor an input, an unknown that is neither a derivative
+    // nor an output: refused, saying so.
+    let mut v = 0.0;
+    let bad = unsafe {
+        inst.lib
+            .fmi2GetDirectionalDerivative(inst.c, &vr::ROOF_X, 1, &vr::STOREYS, 1, &1.0, &mut v)
+    };
+    assert_eq!(bad, ERROR);
+    assert!(
+        inst.logs()
+            .join("\n")
+            .contains("neither a continuous state nor an input")
+    );
+}
