@@ -1,6 +1,7 @@
 //! Call-sequence fuzzing of TLD.fmu (the engine and its invariants: tests/fuzz/mod.rs, shared
 //! with Building.fmu's fuzz test): every sequence starts with a model drawn from every item of
-//! the model enumeration, so that every model gets the same fuzzing.
+//! the model enumeration and either amplitude source, so that every model gets the same
+//! fuzzing, in Co-Simulation and in Model Exchange.
 
 mod common;
 mod fuzz;
@@ -16,13 +17,17 @@ fn random_call_sequences_keep_the_invariants() {
         .iter()
         .map(|m| m.value() as i32)
         .collect();
-    let model = proptest::sample::select(models).prop_map(|model| Call::SetInteger {
-        vrs: vec![vr::MODEL],
-        values: vec![model, 0, 0, 0],
+    // amplitude Fixed (1) or Tracked (2): Model Exchange runs with Fixed only.
+    let model = (proptest::sample::select(models), 1..=2i32).prop_map(|(model, amplitude)| {
+        Call::SetInteger {
+            vrs: vec![vr::MODEL, vr::AMPLITUDE],
+            values: vec![model, amplitude, 0, 0],
+        }
     });
     let target = Target {
         value_references: VARIABLES.iter().map(|v| v.vr).collect(),
         output: vr::FORCE,
+        states: 4,
     };
     fuzz::run(target, fuzz::starting_with(model));
 }

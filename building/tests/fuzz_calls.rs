@@ -20,6 +20,7 @@ fn random_call_sequences_keep_the_invariants() {
     let target = Target {
         value_references: VARIABLES.iter().map(|v| v.vr).collect(),
         output: vr::TLD_A,
+        states: 44,
     };
     fuzz::run(target, fuzz::starting_with(building));
 }

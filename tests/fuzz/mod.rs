@@ -10,6 +10,10 @@
 //!   serialised state, which holds every variable, the time and the simulation state, is
 //!   byte-for-byte the one before the call.
 //!
+//! Each sequence runs on a Co-Simulation or a Model Exchange instance (drawn), and the calls
+//! include Model Exchange's (time, states, derivatives, nominals, event indicators, event and
+//! continuous-time modes, completed steps, directional derivatives).
+//!
 //! The number of sequences is bounded for CI (PROPTEST_CASES overrides it) and printed.
 //!
 //! The instances are the workspace's raw test host's (tests/fmi_host), which every fuzz test
@@ -25,6 +29,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 pub struct Target {
     pub value_references: Vec<u32>,
     pub output: u32,
+    /// Continuous states the model description declares (Model Exchange).
+    pub states: usize,
 }
 
 const SEQUENCES: u32 = 2000;
@@ -105,6 +111,27 @@ pub enum Call {
     CancelStep,
     ModelExchange,
     NullInstance,
+    SetTime {
+        t: f64,
+    },
+    SetStates {
+        values: Vec<f64>,
+    },
+    /// 0: fmi2GetContinuousStates, 1: fmi2GetDerivatives, 2: fmi2GetNominalsOfContinuousStates,
+    /// 3: fmi2GetEventIndicators, of `n` values.
+    StateQuery {
+        which: u8,
+        n: usize,
+    },
+    EventMode,
+    NewDiscreteStates,
+    ContinuousTimeMode,
+    CompletedStep,
+    Directional {
+        unknown: u32,
+        known: u32,
+        dv: f64,
+    },
 }
 
 fn value_reference(known: Vec<u32>) -> impl Strategy<Value = u32> {
@@ -128,8 +155,11 @@ fn step() -> impl Strategy<Value = f64> {
     ]
 }
 
-fn call(known: Vec<u32>) -> impl Strategy<Value = Call> {
+fn call(known: Vec<u32>, states: usize) -> impl Strategy<Value = Call> {
     let vr = move || value_reference(known.clone());
+    let bad = || proptest::sample::select(vec![f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300]);
+    let small = move || prop_oneof![30 => -0.05..0.05f64, 1 => real(), 1 => bad()];
+    let lengths = move || prop_oneof![8 => Just(states), 1 => 0..states + 2];
     let vrs = || proptest::collection::vec(vr(), 0..4);
     let ptr = || prop_oneof![9 => Just(Arg::Valid), 1 => Just(Arg::Null)];
     prop_oneof![
@@ -161,6 +191,15 @@ fn call(known: Vec<u32>) -> impl Strategy<Value = Call> {
         1 => Just(Call::CancelStep),
         1 => Just(Call::ModelExchange),
         1 => Just(Call::NullInstance),
+        3 => prop_oneof![6 => 0.0..1.0f64, 1 => real(), 1 => bad()].prop_map(|t| Call::SetTime { t }),
+        4 => lengths().prop_flat_map(move |n| proptest::collection::vec(small(), n))
+            .prop_map(|values| Call::SetStates { values }),
+        4 => (0..4u8, lengths()).prop_map(|(which, n)| Call::StateQuery { which, n }),
+        2 => Just(Call::EventMode),
+        2 => Just(Call::NewDiscreteStates),
+        3 => Just(Call::ContinuousTimeMode),
+        2 => Just(Call::CompletedStep),
+        1 => (vr(), vr(), real()).prop_map(|(unknown, known, dv)| Call::Directional { unknown, known, dv }),
     ]
 }
 
@@ -297,10 +336,45 @@ impl Fuzz {
                     *all.iter().max().unwrap_or(&OK)
                 }
                 Call::CancelStep => lib.fmi2CancelStep(c),
+                // Two states: the wrong number for every FMU here (refused in every phase).
                 Call::ModelExchange => {
                     let mut x = [0.0; 2];
                     lib.fmi2GetContinuousStates(c, x.as_mut_ptr(), 2)
-                        .max(lib.fmi2SetTime(c, 1.0))
+                }
+                Call::SetTime { t } => lib.fmi2SetTime(c, *t),
+                Call::SetStates { values } => {
+                    lib.fmi2SetContinuousStates(c, values.as_ptr(), values.len())
+                }
+                Call::StateQuery { which, n } => {
+                    let mut out = vec![0.0; *n];
+                    let p = out.as_mut_ptr();
+                    match which {
+                        0 => lib.fmi2GetContinuousStates(c, p, *n),
+                        1 => lib.fmi2GetDerivatives(c, p, *n),
+                        2 => lib.fmi2GetNominalsOfContinuousStates(c, p, *n),
+                        _ => lib.fmi2GetEventIndicators(c, p, *n),
+                    }
+                }
+                Call::EventMode => lib.fmi2EnterEventMode(c),
+                Call::NewDiscreteStates => {
+                    let mut info = fmi2EventInfo {
+                        newDiscreteStatesNeeded: 0,
+                        terminateSimulation: 0,
+                        nominalsOfContinuousStatesChanged: 0,
+                        valuesOfContinuousStatesChanged: 0,
+                        nextEventTimeDefined: 0,
+                        nextEventTime: 0.0,
+                    };
+                    lib.fmi2NewDiscreteStates(c, &mut info)
+                }
+                Call::ContinuousTimeMode => lib.fmi2EnterContinuousTimeMode(c),
+                Call::CompletedStep => {
+                    let (mut enter, mut terminate) = (0, 0);
+                    lib.fmi2CompletedIntegratorStep(c, 1, &mut enter, &mut terminate)
+                }
+                Call::Directional { unknown, known, dv } => {
+                    let mut out = 0.0;
+                    lib.fmi2GetDirectionalDerivative(c, unknown, 1, known, 1, dv, &mut out)
                 }
                 Call::NullInstance => {
                     lib.fmi2DoStep(std::ptr::null_mut(), 0.0, 0.01, 0)
@@ -337,14 +411,23 @@ pub fn run(target: Target, prefix: impl Strategy<Value = Vec<Call>>) {
     };
     let mut runner = proptest::test_runner::TestRunner::new(config);
     let known = target.value_references.clone();
-    let sequences =
-        (prefix, proptest::collection::vec(call(known), 1..40)).prop_map(|(mut p, rest)| {
+    let sequences = (
+        any::<bool>(),
+        prefix,
+        proptest::collection::vec(call(known, target.states), 1..40),
+    )
+        .prop_map(|(me, mut p, rest)| {
             p.extend(rest);
-            p
+            (me, p)
         });
-    let result = runner.run(&sequences, |calls| {
+    let result = runner.run(&sequences, |(me, calls)| {
+        let fmu_type = if me {
+            fmi2Type_fmi2ModelExchange
+        } else {
+            fmi2Type_fmi2CoSimulation
+        };
         let mut fuzz = Fuzz {
-            inst: Instance::new("fuzz"),
+            inst: Instance::of_type("fuzz", fmu_type),
             output: target.output,
             saved: None,
             state: std::ptr::null_mut(),
