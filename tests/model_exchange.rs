@@ -202,3 +202,23 @@ fn states_save_and_restore_in_model_exchange() {
     assert_eq!(status, ERROR);
     assert!(cs.logs().join("\n").contains("Model Exchange"));
 }
+
+/// ME instances integrated in threads give the serial runs' numbers bit for bit (no state
+/// shared between instances, none in the library).
+#[test]
+fn model_exchange_instances_in_threads_match_serial_runs() {
+    let cases: Vec<(i32, f64)> = vec![
+        (LINEAR, 0.01),
+        (NONLINEAR, 0.02),
+        (NONLINEAR, -0.015),
+        (4, 0.03),
+    ];
+    assert_threads_match_serial(&cases, |name, (model, x0)| {
+        let inst = running(&name, model, x0);
+        inst.rk4(N, 0.0, 1.0, 200, |i, t| {
+            assert_eq!(i.set_real(vr::BASE_A, 0.2 * (5.0 * t).sin()), OK);
+        });
+        let (_, x) = inst.states(N);
+        x.iter().fold(0u64, |h, v| h.rotate_left(7) ^ v.to_bits())
+    });
+}
