@@ -124,11 +124,13 @@ fn check(
             "ModelStructure/Outputs must list every output once, in order: {want_outputs:?}, found {got_outputs:?}"
         ));
     }
+    // Model Exchange's continuous states: the variables a derivative names.
+    let states: Vec<usize> = vars.iter().filter_map(|v| v.derivative).collect();
     for (i, d) in outputs {
         for &k in d {
-            if by_index(k, "Outputs").causality != "input" {
+            if by_index(k, "Outputs").causality != "input" && !states.contains(&k) {
                 fail(format!(
-                    "Outputs: output {i} may depend on inputs only, not on variable {k}"
+                    "Outputs: output {i} may depend on inputs and continuous states only, not on variable {k}"
                 ));
             }
         }

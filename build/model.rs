@@ -22,6 +22,8 @@ pub struct Var {
     pub min: Option<String>,
     pub max: Option<String>,
     pub unit: Option<String>,
+    /// Model Exchange: the index of the state this variable is the derivative of.
+    pub derivative: Option<usize>,
     pub description: String,
 }
 
@@ -247,6 +249,14 @@ pub fn read(text: &str) -> Description {
                 v.min = a.get("min").cloned();
                 v.max = a.get("max").cloned();
                 v.unit = a.get("unit").cloned();
+                v.derivative = a.get("derivative").map(|d| {
+                    d.parse().unwrap_or_else(|_| {
+                        fail(format!(
+                            "variable '{}': derivative=\"{d}\" is no index",
+                            v.name
+                        ))
+                    })
+                });
             }
             b"Outputs" => section = "Outputs".into(),
             b"InitialUnknowns" => section = "InitialUnknowns".into(),

@@ -110,6 +110,9 @@ fn the_input_enters_the_derivative_of_the_velocity() {
 fn calls_out_of_order_say_what_to_call_first() {
     let inst = in_initialisation("me-order", NONLINEAR, 0.0);
     assert_eq!(inst.derivatives(N).0, ERROR);
+    // The derivative variables are initial unknowns: readable in initialisation mode (FMI
+    // Library hosts read them there), from the state the parameters start.
+    assert_eq!(inst.get_real(vr::DER_SLOSH_X_), (OK, 0.0));
     assert_eq!(inst.exit(), OK);
     // Event mode: states are set in continuous-time mode only.
     assert_eq!(inst.set_states(&[0.0; N]), ERROR);

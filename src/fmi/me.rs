@@ -33,8 +33,14 @@ impl Tld {
         ]
         .iter()
         .position(|&d| d == r)?;
-        let mut dx = [0.0; STATES];
-        Some(self.derivatives(context, &mut dx).map(|_| dx[k]))
+        // Before initialisation (hosts read the initial unknowns in initialisation mode): from
+        // the simulation the parameters set so far would start.
+        let mut provisional = None;
+        let inputs = self.values.inputs([0.0; 2]);
+        Some(
+            self.simulation(context, &mut provisional)
+                .map(|sim| sim.continuous_derivatives(&inputs)[k]),
+        )
     }
 }
 

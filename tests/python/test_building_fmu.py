@@ -328,7 +328,13 @@ def test_capabilities_and_model_structure(building_path):
     assert cs.modelIdentifier == "Building" and cs.canHandleVariableCommunicationStepSize
     assert cs.canInterpolateInputs and cs.maxOutputDerivativeOrder >= 1
     assert cs.canGetAndSetFMUstate and cs.canSerializeFMUstate and not cs.needsExecutionTool
-    deps = {u.variable.name: {d.name for d in (u.dependencies or [])} for u in md.outputs}
+    all_deps = {u.variable.name: {d.name for d in (u.dependencies or [])} for u in md.outputs}
+    inputs = {v.name for v in md.modelVariables if v.causality == "input"}
+    # on inputs (Co-Simulation's feedthrough); the rest are Model Exchange's continuous states
+    deps = {n: d & inputs for n, d in all_deps.items()}
+    states = {d.variable.derivative.name for d in md.derivatives}
+    assert len(states) == 44 and all(d - inputs <= states for d in all_deps.values())
+    assert all_deps["roof.x"] == {f"floor[{i}].x" for i in range(1, 21)}
     floors = {f"floor[{i}].force" for i in range(1, 21)}
     assert deps["tld.a"] == {"tld.force"} | floors
     for i in range(1, 21):

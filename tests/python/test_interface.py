@@ -96,8 +96,10 @@ def test_fmu_md_capabilities(model_description):
 
 
 def test_model_structure(model_description):
-    deps = {u.variable.name: {d.name for d in (u.dependencies or [])}
-            for u in model_description.outputs}
+    all_deps = {u.variable.name: {d.name for d in (u.dependencies or [])}
+                for u in model_description.outputs}
+    inputs = {v.name for v in model_description.modelVariables if v.causality == "input"}
+    deps = {n: d & inputs for n, d in all_deps.items()}
     outputs = [n for n, c in FMU_MD_VARIABLES.items() if c == "output"]
     assert set(outputs) <= set(deps)
     # force depends on the state only; base_shear feeds through base.a (FMU.md)
@@ -106,6 +108,11 @@ def test_model_structure(model_description):
     for n in outputs:
         if n != "base_shear":
             assert deps[n] == set(), f"{n} declared to depend on {deps[n]}"
+    # Model Exchange: the rest of each output's dependencies are continuous states
+    states = {d.variable.derivative.name for d in model_description.derivatives}
+    assert states == {"slosh.x", "slosh.v", "energy.input", "energy.dissipated"}
+    assert all(d - inputs <= states for d in all_deps.values())
+    assert all_deps["force"] == {"slosh.x", "slosh.v"}
 
 
 GEOMETRIES = [

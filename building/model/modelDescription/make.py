@@ -10,11 +10,9 @@ MASS, STIFFNESS = 168.0, 5342.0
 
 vars = []  # (name, vr, causality, variability, initial, type, attrs, description)
 
-
 def add(name, vr, causality, variability, ty, description, initial=None, **attrs):
     vars.append((name, vr, causality, variability, initial, ty, attrs, description))
     return len(vars)  # 1-based index
-
 
 P = dict(causality="parameter", variability="fixed", initial="exact")
 storeys = add("storeys", 0, ty="Integer", start=1, min=1, max=N,
@@ -99,32 +97,32 @@ for k, (name, unit) in enumerate([("ground.x", "m/s"), ("ground.v", "m/s2"), ("g
     ders.append(add(f"der({name})", 54 + k, ty="Real", unit=unit, derivative=states[2 * N + k],
                     description=f"time derivative of {name}", **D))
 
-
 def deps(xs):
     return " ".join(str(x) for x in sorted(xs))
-
 
 structure = [storeys, tld_floor, tld_mass] + masses
 everything = structure + stiffs + [zeta, zeta1, zeta2]
 forces = [tld_force] + floor_f
 outputs = []  # (index, output deps, initial deps)
-outputs.append((tld_a, forces, forces + structure))
+# Outputs depend on inputs and (Model Exchange) on the continuous states.
+outputs.append((tld_a, forces + floor_x + floor_v, forces + structure))
 # tld.v starts at the built-in ground motion's velocity A omega
-outputs.append((tld_v, [], [ground_amp, ground_w]))
-for k in [tld_x, roof_x, shear] + floor_x:
-    outputs.append((k, [], []))
+outputs.append((tld_v, floor_v + [ground_v], [ground_amp, ground_w]))
+outputs.append((tld_x, floor_x + [ground_x], []))
+outputs.append((roof_x, floor_x, []))
+outputs.append((shear, floor_x[:1] + floor_v, []))
+for k in floor_x:
+    outputs.append((k, [k], []))
 for i, k in enumerate(floor_a):
-    outputs.append((k, [tld_force, floor_f[i]], [tld_force, floor_f[i]] + structure))
+    outputs.append((k, [tld_force, floor_f[i]] + floor_x + floor_v, [tld_force, floor_f[i]] + structure))
 outputs.sort()
 initial = sorted(outputs + [(k, None, everything) for k in [w1, w2, alpha, beta]])
 initial += [(ground_v, None, [ground_amp, ground_w]), (ground_hv, None, [ground_amp, ground_w])]
 initial += [(k, None, everything + [ground_a, ground_amp, ground_w] + forces) for k in ders]
 initial.sort()
 
-
 def attr_text(attrs):
     return " ".join(f'{k}="{v}"' for k, v in attrs.items())
-
 
 lines = ['<?xml version="1.0" encoding="UTF-8"?>',
          "<!-- The single source of truth for Building.fmu's variables, written by make.py (edit that,",
@@ -141,6 +139,16 @@ lines = ['<?xml version="1.0" encoding="UTF-8"?>',
   variableNamingConvention="structured"
   numberOfEventIndicators="0">
 
+  <ModelExchange
+    modelIdentifier="Building"
+    needsExecutionTool="false"
+    completedIntegratorStepNotNeeded="true"
+    canBeInstantiatedOnlyOncePerProcess="false"
+    canNotUseMemoryManagementFunctions="true"
+    canGetAndSetFMUstate="true"
+    canSerializeFMUstate="true"
+    providesDirectionalDerivative="true"/>
+
   <CoSimulation
     modelIdentifier="Building"
     needsExecutionTool="false"
@@ -153,16 +161,6 @@ lines = ['<?xml version="1.0" encoding="UTF-8"?>',
     canGetAndSetFMUstate="true"
     canSerializeFMUstate="true"
     providesDirectionalDerivative="false"/>
-
-  <ModelExchange
-    modelIdentifier="Building"
-    needsExecutionTool="false"
-    completedIntegratorStepNotNeeded="true"
-    canBeInstantiatedOnlyOncePerProcess="false"
-    canNotUseMemoryManagementFunctions="true"
-    canGetAndSetFMUstate="true"
-    canSerializeFMUstate="true"
-    providesDirectionalDerivative="true"/>
 
   <UnitDefinitions>
     <Unit name="1"/>

@@ -107,18 +107,23 @@ impl Building {
         } else {
             (false, 2 * m + within(vr::DER_GROUND_X_, 4)?)
         };
-        let context = Context {
-            phase: fmi2_slave::calls::Phase::EventMode,
-            experiment: Default::default(),
-            time: 0.0,
+        // Before initialisation (the host reads the initial unknowns in initialisation mode):
+        // from the simulation the parameters set so far would start.
+        let s = match self.simulation() {
+            Ok(s) => s,
+            Err(e) => return Some(Err(e)),
+        };
+        let n = s.building.n;
+        let values: Vec<f64> = if state {
+            s.z.to_vec()
+        } else {
+            self.rates(&s).iter().copied().collect()
         };
         let mut out = [0.0; STATES];
-        let done = if state {
-            self.states(&mut out)
-        } else {
-            self.derivatives(&context, &mut out)
-        };
-        Some(done.map(|_| out[p]))
+        for (k, v) in values.iter().enumerate() {
+            out[padded(k, n)] = *v;
+        }
+        Some(Ok(out[p]))
     }
 }
 
