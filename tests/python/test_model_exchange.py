@@ -79,15 +79,17 @@ def test_linear_one_mode_against_its_exact_solution(fmu_path, rtol):
     assert np.max(np.abs(bal)) < 1e-6 * np.max(np.abs(res["energy.input"]))
 
 
+@pytest.mark.parametrize("model", ["Nonlinear", "Auto"])
 @pytest.mark.parametrize("rtol", sorted(BOUND))
-def test_nonlinear_against_dop853(fmu_path, rtol):
+def test_nonlinear_against_dop853(fmu_path, rtol, model):
+    """Auto in ME is the Nonlinear equations (its exact-linear shortcut steps Co-Simulation)."""
     t, a, _ = base_input()
-    res = at(run_tld(fmu_path, item("model", "Nonlinear"), rtol=rtol), t)
+    res = at(run_tld(fmu_path, item("model", model), rtol=rtol), t)
     p = R.TLD().with_(damping=R.DAMPING_CONSTANT, zeta=ZETA)
     _, xs, vs = R.simulate_held_scipy(p, DT, a[:-1], rtol=1e-12, zeta=ZETA)
     ex, ev = R.rel_err(res["slosh.x"], np.array(xs)), R.rel_err(res["slosh.v"], np.array(vs))
     ef = R.rel_err(res["force"], p.force(np.array(xs), np.array(vs), zeta=ZETA))
-    print(f"Nonlinear in ME (CVode {rtol:g}): slosh.x {ex:.2e}, slosh.v {ev:.2e}, force {ef:.2e} of peak")
+    print(f"{model} in ME (CVode {rtol:g}): slosh.x {ex:.2e}, slosh.v {ev:.2e}, force {ef:.2e} of peak")
     assert ex < BOUND[rtol] and ev < BOUND[rtol] and ef < BOUND[rtol]
 
 
