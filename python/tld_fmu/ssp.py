@@ -316,9 +316,11 @@ def validate(xml: str, schema: str):
                          + "\n".join(f"  line {e.line}: {e.message}" for e in xsd.error_log))
 
 
-def contents(name: str, tld_fmu: Path = FMU, building_fmu: Path = BUILDING_FMU) -> dict:
-    """The text files of system `name`'s archive {path in the archive: text}, validated."""
-    description, make, (stop, step) = SYSTEMS[name]
+def contents(name: str, tld_fmu: Path = FMU, building_fmu: Path = BUILDING_FMU, system=None) -> dict:
+    """The text files of system `name`'s archive {path in the archive: text}, validated. system:
+    (description, configuration, (stop, step)) as in SYSTEMS, for a system not listed there
+    (scripts/tower.py's)."""
+    description, make, (stop, step) = system or SYSTEMS[name]
     cfg = make()
     tld, bld = Contract(str(tld_fmu)), Contract(str(building_fmu))
     tp = tld_parameters(cfg, tld)
@@ -333,9 +335,9 @@ def contents(name: str, tld_fmu: Path = FMU, building_fmu: Path = BUILDING_FMU) 
 
 
 def write(name: str, out_dir: Path = SYSTEMS_DIR, tld_fmu: Path = FMU,
-          building_fmu: Path = BUILDING_FMU) -> Path:
+          building_fmu: Path = BUILDING_FMU, system=None) -> Path:
     """Write systems/<name>.ssp: the text files of `contents` and both FMUs."""
-    files = contents(name, tld_fmu, building_fmu)
+    files = contents(name, tld_fmu, building_fmu, system)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     path = out_dir / f"{name}.ssp"
