@@ -54,6 +54,11 @@ def design(cfg, unzipdir, md):
     liquid, slosh, inactive, omega_f = probe.fmu.getReal([vr("mass.liquid"), vr("mass.slosh"),
                                                           vr("mass.inactive"), vr("omega_f")])
     probe.close()
+    # the damping ratio boundary layers alone give this tank (damping = BoundaryLayer)
+    bl = building.Damper(unzipdir, md, d["floor"], d.get("tanks", 1), {**d.get("params", {}), "damping": "BoundaryLayer"},
+                         "probe_bl")
+    zeta_bl = bl.fmu.getReal([bl.var["zeta.effective"].valueReference])[0]
+    bl.close()
     bare = building.Building(b["masses"], b["stiffnesses"], b["rayleigh"])
     w2, vec = building.np_eig(bare.K, np.diag(bare.M))
     s = 1 / np.sqrt(np.diag(bare.M))
@@ -69,7 +74,7 @@ def design(cfg, unzipdir, md):
             "depth": p["tank.depth"], "water": liquid, "water_per_tank": liquid / d.get("tanks", 1),
             "slosh": slosh, "inactive": inactive, "f_slosh": omega_f / (2 * math.pi),
             "tuning": omega_f / loaded.omega1, "mass_ratio": liquid / modal, "slosh_ratio": slosh / modal,
-            "damping": str(p.get("damping", "NSD"))}
+            "damping": str(p.get("damping", "NSD")), "zeta_boundary_layer": zeta_bl}
 
 
 def stats(run, level_height, keep):
@@ -160,7 +165,7 @@ def main(argv=None):
           f"(h/a = {d['depth'] / d['length']:.3f}), {d['water_per_tank'] / 1e3:.1f} t each, {d['water'] / 1e3:.0f} t in all: "
           f"mass ratio {100 * d['mass_ratio']:.2f} % (sloshing mass {100 * d['slosh_ratio']:.2f} %)")
     print(f"sloshing {d['f_slosh']:.4f} Hz (Eq 2.2) vs building {d['f1']:.4f} Hz: ratio {d['tuning']:.4f}; "
-          f"damping law {d['damping']}")
+          f"damping law {d['damping']} (BoundaryLayer would give {100 * d['zeta_boundary_layer']:.2f} %)")
 
     # ---- wind
     load = cfg["load"]
@@ -363,8 +368,8 @@ def report(s, wind, quake, ws, qs, out, figs, args, plt):
           "sloshing-mass ratio is 0.99; the NSD model stiffens with the amplitude, so 1.00 is kept.)", "",
           "**Why NSD damping, not BoundaryLayer.** `damping` = BoundaryLayer is the laminar boundary "
           "layers' damping of clean water on smooth walls: it falls with the tank's size (as "
-          "sqrt(nu / omega) / h) and is a fraction of a per cent in an 8 m tank, far below what the "
-          "damper needs; real full-scale tanks get their damping from screens, baffles and wave "
+          f"sqrt(nu / omega) / h) and is {100 * d['zeta_boundary_layer']:.2f} % in this tank (its zeta.effective), "
+          "far below what the damper needs; real full-scale tanks get their damping from screens, baffles and wave "
           "breaking. NSD (Yu, Wakahara & Reed's fit of experiments, zeta = 0.5 Lambda^0.35 in "
           "Lambda = A_e / a) is written in the tank's own scale, so it carries over to an 8 m tank; "
           "it stands here for a tank whose screens are designed to give about that damping. The "
