@@ -95,6 +95,7 @@ fn dam_breaks_converge_to_ritter_and_stoker() {
                 depth: 0.1,
                 g_e: 9.81,
                 cells,
+                screens: super::screens::ScreenCells::NONE,
             };
             let mut f = ch.at_rest();
             for i in 0..cells {
@@ -506,6 +507,7 @@ fn bore_speed_and_loss_follow_rankine_hugoniot() {
         depth: 0.1,
         g_e: 9.81,
         cells: 400,
+        screens: super::screens::ScreenCells::NONE,
     };
     let x0 = 0.4;
     let mut f = ch.at_rest();
