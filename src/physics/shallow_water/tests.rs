@@ -572,3 +572,6 @@ fn an_hour_of_violent_sloshing_conserves_mass() {
 /// The scheme's limits and edges: the dry depth and films, the CFL substeps and their retry,
 /// the step limit, the desingularised velocity, one and two cells, mirror symmetry.
 mod limits;
+
+/// Damping screens: closed-form equivalent damping, convergence, conservation.
+mod screens;
