@@ -481,3 +481,64 @@ fn screens_law_matches_the_shallow_water_model_at_small_amplitude() {
         assert!((kappa - 1.0).abs() < 0.02, "{kappa}");
     }
 }
+
+/// The report behind docs/SCREENS-SWEEP.md (scripts/screens-report runs it in a release build:
+/// `cargo test --release --lib -- --ignored screens_law_report --nocapture`): the shallow-water
+/// model with Tait's pair (S = 0.5 and 0.7) at `swe.cells` = 150, 64 steps per cycle, swept
+/// up through resonance at Lambda 0.001 to 0.1; the model's equivalent damping and response at
+/// quadrature against the Screens law, and the Linear model with damping = Screens (amplitude
+/// Fixed at A_e) swept the same way. Prints a Markdown table; asserts only that every sweep
+/// passed quadrature.
+#[test]
+#[ignore = "a report (scripts/screens-report), about a minute in a release build"]
+fn screens_law_report() {
+    let plan = Plan {
+        from: 0.9,
+        to: 1.5,
+        step: 0.02,
+        settling: Settling {
+            steps_per_cycle: 64,
+            tolerance: 2e-3,
+            ..Settling::default()
+        },
+    };
+    println!(
+        "| S | Lambda | SWE kappa | SWE zeta_eq | SWE X/a | law at SWE X | law at A_e | \
+         Linear+Screens X/a | SWE X / Linear X |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for s in [0.5, 0.7] {
+        let screens = |p: StartValues| {
+            p.with(vr::DAMPING, item(DampingLawItem::Screens as i64))
+                .with(vr::SCREENS_COUNT, 2.0)
+                .with(vr::SCREENS_SOLIDITY, s)
+                .with(vr::SCREENS_SPACING, 0.05)
+        };
+        let swe = screens(table21(ModelKindItem::ShallowWater, 0.0)).with(vr::SWE_CELLS, 150.0);
+        let (common, _) = crate::model::Common::read(&swe).expect("parameters");
+        let crate::physics::laws::DampingLaw::Screens {
+            boundary,
+            per_response,
+        } = common.damping
+        else {
+            panic!("not the Screens law")
+        };
+        for lambda in [0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1] {
+            let c = characterise(&swe, lambda, &plan).expect("sweep");
+            let (kappa, zeta) = c.quadrature.expect("quadrature");
+            let x = c.peak.x;
+            let linear = screens(table21(ModelKindItem::Linear, 0.0))
+                .with(vr::A_E, lambda * 0.25)
+                .with(vr::MODES, 1.0);
+            let l = characterise(&linear, lambda, &plan).expect("sweep");
+            println!(
+                "| {s} | {lambda} | {kappa:.3} | {zeta:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.3} |",
+                x / 0.25,
+                boundary + per_response * x,
+                common.zeta(lambda * 0.25),
+                l.peak.x / 0.25,
+                x / l.peak.x
+            );
+        }
+    }
+}
