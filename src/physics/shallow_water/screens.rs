@@ -115,3 +115,29 @@ impl ScreenCells {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A screen's loss is shared by the two cells whose centres bracket it, with the linear
+    /// weights (all of it in the wall cell beyond the first centre); two screens in one cell
+    /// add up.
+    #[test]
+    fn screens_are_shared_between_the_bracketing_cells() {
+        let (dx, c_l) = (0.1, 2.0);
+        let unit = c_l / (2.0 * dx);
+        let near = |got: f64, want: f64| (got - want).abs() < 1e-12 * want;
+        let s = ScreenCells::new(&[0.27], c_l, dx, 10);
+        let e: Vec<_> = s.entries().collect();
+        assert_eq!(e.len(), 2);
+        assert!(e[0].0 == 2 && near(e[0].1, 0.8 * unit), "{e:?}");
+        assert!(e[1].0 == 3 && near(e[1].1, 0.2 * unit), "{e:?}");
+        let s = ScreenCells::new(&[0.01, 0.02, 0.97], c_l, dx, 10);
+        let e: Vec<_> = s.entries().collect();
+        assert_eq!(e.len(), 2, "{e:?}");
+        assert!(e[0].0 == 0 && near(e[0].1, 2.0 * unit), "{e:?}");
+        assert!(e[1].0 == 9 && near(e[1].1, unit), "{e:?}");
+        assert!(ScreenCells::NONE.is_empty() && !s.is_empty());
+    }
+}
