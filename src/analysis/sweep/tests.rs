@@ -426,6 +426,28 @@ fn shallow_water_hardens_and_dissipates_as_the_mechanical_models() {
     assert!(z_large > 2.0 * z_small, "{z_small} {z_large}");
 }
 
+/// `p` with damping = Screens and Tait's pair of screens of solidity `s` at 0.4 a and 0.6 a of
+/// the lab tank.
+fn tait_pair(p: StartValues, s: f64) -> StartValues {
+    p.with(vr::DAMPING, item(DampingLawItem::Screens as i64))
+        .with(vr::SCREENS_COUNT, 2.0)
+        .with(vr::SCREENS_SOLIDITY, s)
+        .with(vr::SCREENS_SPACING, 0.05)
+}
+
+/// The Screens law `p` configures: the shared parameters, zeta_BL and K (zeta_s = K X).
+fn screens_law(p: &StartValues) -> (crate::model::Common, f64, f64) {
+    let (common, _) = crate::model::Common::read(p).expect("parameters");
+    let crate::physics::laws::DampingLaw::Screens {
+        boundary,
+        per_response,
+    } = common.damping
+    else {
+        panic!("not the Screens law")
+    };
+    (common, boundary, per_response)
+}
+
 /// The `Screens` damping law against the shallow-water model with the same screens (Tait's
 /// pair at 0.4 a and 0.6 a, S = 0.5, in the lab tank; model = ShallowWater with damping =
 /// Screens takes the boundary layers' drag and resolves the screens), swept up through
@@ -436,12 +458,7 @@ fn shallow_water_hardens_and_dissipates_as_the_mechanical_models() {
 /// docs/SCREENS.md's (scripts/screens-report).
 #[test]
 fn screens_law_matches_the_shallow_water_model_at_small_amplitude() {
-    let p = table21(ModelKindItem::ShallowWater, 0.0)
-        .with(vr::DAMPING, item(DampingLawItem::Screens as i64))
-        .with(vr::SCREENS_COUNT, 2.0)
-        .with(vr::SCREENS_SOLIDITY, 0.5)
-        .with(vr::SCREENS_SPACING, 0.05)
-        .with(vr::SWE_CELLS, 32.0);
+    let p = tait_pair(table21(ModelKindItem::ShallowWater, 0.0), 0.5).with(vr::SWE_CELLS, 32.0);
     let plan = Plan {
         from: 0.9,
         to: 1.3,
@@ -452,14 +469,7 @@ fn screens_law_matches_the_shallow_water_model_at_small_amplitude() {
             ..Settling::default()
         },
     };
-    let (common, _) = crate::model::Common::read(&p).expect("parameters");
-    let crate::physics::laws::DampingLaw::Screens {
-        boundary,
-        per_response,
-    } = common.damping
-    else {
-        panic!("not the Screens law")
-    };
+    let (common, boundary, per_response) = screens_law(&p);
     for lambda in [0.001, 0.005] {
         let c = characterise(&p, lambda, &plan).expect("sweep");
         let (kappa, zeta) = c.quadrature.expect("quadrature");
@@ -508,21 +518,9 @@ fn screens_law_report() {
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     for s in [0.5, 0.7] {
-        let screens = |p: StartValues| {
-            p.with(vr::DAMPING, item(DampingLawItem::Screens as i64))
-                .with(vr::SCREENS_COUNT, 2.0)
-                .with(vr::SCREENS_SOLIDITY, s)
-                .with(vr::SCREENS_SPACING, 0.05)
-        };
+        let screens = |p: StartValues| tait_pair(p, s);
         let swe = screens(table21(ModelKindItem::ShallowWater, 0.0)).with(vr::SWE_CELLS, 150.0);
-        let (common, _) = crate::model::Common::read(&swe).expect("parameters");
-        let crate::physics::laws::DampingLaw::Screens {
-            boundary,
-            per_response,
-        } = common.damping
-        else {
-            panic!("not the Screens law")
-        };
+        let (common, boundary, per_response) = screens_law(&swe);
         for lambda in [0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1] {
             let c = characterise(&swe, lambda, &plan).expect("sweep");
             let (kappa, zeta) = c.quadrature.expect("quadrature");
