@@ -92,7 +92,7 @@ fn length_for(omega: f64, r: f64) -> f64 {
 /// The solidity of a slat screen with loss coefficient `c_l` (C_l(S) inverted by bisection on
 /// [0, 0.95]; None beyond).
 pub fn solidity_for(c_l: f64) -> Option<f64> {
-    if !(c_l >= 0.0) || c_l > loss_coefficient(0.95) {
+    if c_l.is_nan() || c_l < 0.0 || c_l > loss_coefficient(0.95) {
         return None;
     }
     let (mut lo, mut hi) = (0.0, 0.95);
@@ -153,7 +153,7 @@ pub fn design(s: &Structure, l: &Limits) -> Result<Design, String> {
             // Shallower: tanh(pi r) = a_max omega^2/(g pi).
             let t = l.length * omega_1 * omega_1 / (G * PI);
             r = t.atanh() / PI;
-            if !(r >= 0.02) {
+            if r.is_nan() || r < 0.02 {
                 return Err(format!(
                     "a tank tuned to {:.3} Hz needs a length of {a:.2} m even at h/a = 0.02: \
                      the footprint ({} m) is too short",
