@@ -18,13 +18,15 @@ import multiprocessing as mp
 import os
 import sys
 import tempfile
-import tomllib
 from pathlib import Path
 
 import numpy as np
 
+from tld_fmu import fmulog
 from tld_fmu import peaks as pk
-from tld_fmu.building import Building, harmonic_ground, record_ground, simulate, wind_forces
+from tld_fmu.building import Building, check_plausible, harmonic_ground, record_ground, simulate, wind_forces
+from tld_fmu.contract import Contract
+from tld_fmu.studyfile import StudyError, load_building
 from tld_fmu.paths import FMU, REPO
 
 
@@ -36,15 +38,24 @@ def main(argv=None):
     ap.add_argument("--xtol", type=float, default=2e-3,
                     help="harmonic sweep: tolerance of the refined peak frequencies, in w/w_1 (default 0.002)")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: one per core)")
+    ap.add_argument("--force", action="store_true",
+                    help=f"run a configuration refused as implausible (water mass above "
+                         f"{fmulog.MASS_RATIO_MAX:g} of the modal mass); its results are flagged")
     args = ap.parse_args(argv)
-    cfg = tomllib.loads(Path(args.config).read_text())
     from fmpy import extract, read_model_description
     from tqdm import tqdm
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    if not Path(args.fmu).is_file():
+        raise SystemExit(f"{args.fmu} not found: run scripts/package first")
     md = read_model_description(args.fmu)
+    try:
+        cfg = load_building(Path(args.config), Contract(md))
+    except StudyError as e:
+        raise SystemExit(f"scripts/building.py: {e}") from None
     unzipdir = extract(args.fmu, tempfile.mkdtemp())
+    check_plausible(cfg, unzipdir, md, args.force)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     load, h = cfg["load"], cfg["coupling"]["step"]
@@ -65,12 +76,13 @@ def main(argv=None):
                                     load.get("band", [0.02, 5.0]), load.get("corner", 0.1),
                                     load.get("coherence", 0.5), load.get("seed", 1))
         runs = {}
-        for damped in tqdm((False, True), desc=load["kind"]):
+        for damped in tqdm((False, True), desc=load["kind"], disable=None):
             runs[damped] = simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=damped,
                                    floor_forces=forces, derivatives=derivs)
         write_histories(out, load["kind"], runs[True], runs[False], plt)
     else:
         sys.exit(f"unknown load kind {load['kind']!r}: harmonic, record or wind")
+    fmulog.REPORT.print_summary()
 
 
 _RUN = {}   # what the sweep's worker processes need (set before the pool forks)
@@ -83,7 +95,18 @@ def _roof_peak(job):
     s = simulate(cfg, unzipdir, md, harmonic_ground(r * w1, load["ground_amplitude"]), h, load["duration"],
                  with_dampers=damped, derivatives=derivs)
     tail = s["t"] > load["duration"] - 20.0
-    return float(np.max(np.abs(s["X"][tail, -1])))
+    # the FMU's warnings go back to the parent, which shows them (a worker's line would land in
+    # the parent's progress bar)
+    return float(np.max(np.abs(s["X"][tail, -1]))), fmulog.REPORT.drain()
+
+
+def _peaks(results):
+    """The peaks of _roof_peak's results; their warnings merged into this process's report."""
+    out = []
+    for peak, warned in results:
+        fmulog.REPORT.merge(warned)
+        out.append(peak)
+    return out
 
 
 def sweep(cfg, unzipdir, md, out, args, plt):
@@ -101,14 +124,14 @@ def sweep(cfg, unzipdir, md, out, args, plt):
                 derivs=bool(cfg["coupling"].get("derivatives", False)))
     ratios = np.linspace(load["from"], load["to"], load["points"])
     jobs = [(damped, float(r)) for r in ratios for damped in (False, True)]
-    with mp.get_context("fork").Pool(max(1, min(args.jobs, len(jobs)))) as pool:
-        got = list(tqdm(pool.imap(_roof_peak, jobs), total=len(jobs), desc="sweep grid"))
+    with mp.get_context("fork").Pool(max(1, min(args.jobs, len(jobs))), initializer=fmulog.quiet_worker) as pool:
+        got = _peaks(tqdm(pool.imap(_roof_peak, jobs), total=len(jobs), desc="sweep grid", disable=None))
         grid = {False: np.array(got[0::2]), True: np.array(got[1::2])}
-        bar = tqdm(desc="peak refinement runs")
+        bar = tqdm(desc="peak refinement runs", disable=None)
 
         def evaluate(batch):
             bar.update(len(batch))
-            return pool.map(_roof_peak, batch)
+            return _peaks(pool.map(_roof_peak, batch))
 
         found = pk.refine_curves({d: (ratios, grid[d]) for d in (False, True)}, evaluate, args.xtol)
         bar.close()

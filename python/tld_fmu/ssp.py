@@ -56,6 +56,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from . import fmulog
 from .contract import Contract
 from .paths import BUILDING_FMU, FMU, REPO
 from .ssp_hosts import HOSTS, load_tbb, run_ecos, run_fmpy, run_libcosim  # noqa: F401  (the hosts, here too)
@@ -152,7 +153,8 @@ def inactive_mass(tld_fmu: Path, params: dict) -> float:
     with tempfile.TemporaryDirectory(prefix="tld_ssp_") as d:
         fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(tld_fmu), d),
                         modelIdentifier=md.coSimulation.modelIdentifier, instanceName="mass")
-        fmu.instantiate()
+        cb = fmulog.callbacks()   # warnings to fmulog.REPORT, each on its own line
+        fmu.instantiate(callbacks=cb)
         try:
             contract.initialise(fmu, params)
             return fmu.getReal([contract.vr("mass.inactive")])[0]
