@@ -216,3 +216,16 @@ def test_summary_of_nothing_says_none():
     buf = io.StringIO()
     fmulog.Report().print_summary(buf)
     assert buf.getvalue().startswith("warnings: none")
+
+
+def test_ssp_run_answers_with_units_and_the_undamped_building(tmp_path, fmu_path, building_path):
+    """The SSP runner: maxima with their units, the same building without the damper beside
+    them, and no libcosim warning about the Enumerations it ignores (explained in the code)."""
+    from tld_fmu import ssp
+    arch = ssp.write("tld_table21", tmp_path)
+    r = run(PY, "-m", "tld_fmu.ssp", "run", str(arch), "--host", "libcosim", "--duration", "10")
+    assert r.returncode == 0, r.stderr
+    assert "max|Building.roof.x| = " in r.stdout and " m, max|Building.base_shear| = " in r.stdout, r.stdout
+    line = next(ln for ln in r.stdout.splitlines() if ln.strip().startswith("max|Building.roof.x|:"))
+    assert "m without" in line and "with the damper" in line and "% less" in line, line
+    assert "Enumeration variable type not supported" not in r.stdout + r.stderr
