@@ -200,8 +200,6 @@ def write_histories(out, kind, s, bare, plt):
     bare_drift = np.diff(np.column_stack([np.zeros(len(bare["t"])), bare["X"]]), axis=1)
     less = lambda a, b: f"rms {1e3 * rms(b):.2f} -> {1e3 * rms(a):.2f} mm, {100 * (1 - rms(a) / rms(b)):.0f} % less"  # noqa: E731
     fig, ax = plt.subplots(5, 1, figsize=(9, 12), gridspec_kw={"height_ratios": [1.2, 1, 1, 1, 1]})
-    for a_ in ax[2:]:
-        a_.sharex(ax[1])
     # storey drifts: rms and peak per storey, without and with the dampers (a time history of
     # several storeys on top of each other hides the reduction)
     storeys = np.arange(1, drift.shape[1] + 1)
@@ -217,23 +215,73 @@ def write_histories(out, kind, s, bare, plt):
                        (storeys[i], 1e3 * max(p0, p1)), textcoords="offset points", xytext=(0, 8), ha="center",
                        fontsize=8)
     ax[0].set_xticks(storeys, [f"storey {i}" for i in storeys])
-    ax[0].set_xlim(0.4, drift.shape[1] + 1.6)
+    ax[0].set_xlim(0.4, drift.shape[1] + 0.6)
     ax[0].set_ylim(0, 1.45e3 * max(peak(bare_drift), peak(drift)))
-    ax[0].set_ylabel("storey drift [mm]"); ax[0].legend(loc="upper right", fontsize=7)
+    ax[0].set_ylabel("storey drift [mm]")
+    ax[0].legend(fontsize=7, ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.12), frameon=False)
     ax[0].set_title("storey drifts over the whole run", fontsize=9)
-    ax[1].plot(bare["t"], bare["X"][:, -1] * 1e3, "k", lw=0.6, label="without dampers")
-    ax[1].plot(s["t"], s["X"][:, -1] * 1e3, "C0", lw=0.6,
-               label=f"with TLD.fmu ({less(s['X'][:, -1], bare['X'][:, -1])})")
-    ax[1].set_ylabel("roof displ. [mm]"); ax[1].legend(loc="upper right", fontsize=7)
-    ax[2].plot(bare["t"], bare["A"][:, -1], "k", lw=0.6, label="without dampers")
-    ax[2].plot(s["t"], s["A"][:, -1], "C0", lw=0.6,
-               label=f"with TLD.fmu (rms {rms(bare['A'][:, -1]):.3f} -> {rms(s['A'][:, -1]):.3f} m/s2, "
-                     f"{100 * (1 - rms(s['A'][:, -1]) / rms(bare['A'][:, -1])):.0f} % less)")
-    ax[2].set_ylabel("roof acc. [m/s2]"); ax[2].legend(loc="upper right", fontsize=7)
-    ax[3].plot(s["t"], s["F"], lw=0.6); ax[3].set_ylabel("damper force [N]")
-    ax[4].plot(s["t"], s["E"]); ax[4].set_ylabel("dissipated [J]"); ax[4].set_xlabel("t [s]")
+    t = s["t"]
+    long = t[-1] > 60.0
+    if long:
+        # a long record's oscillations fill the panel solid: the running rms over 10 s shows how
+        # the response evolves, and a 20 s window around the bare building's largest roof
+        # displacement shows the oscillations themselves
+        n = max(1, int(round(10.0 / (t[1] - t[0]))))
+
+        def running(y):
+            c = np.concatenate([[0.0], np.cumsum(y * y)])
+            out = np.sqrt((c[n:] - c[:-n]) / n)
+            return t[n // 2:n // 2 + len(out)], out
+
+        for y0, y1, unit, scale, k in ((bare["X"][:, -1], s["X"][:, -1], "mm", 1e3, 1),
+                                       (bare["A"][:, -1], s["A"][:, -1], "m/s2", 1.0, 3)):
+            tt, r0 = running(y0)
+            _, r1 = running(y1)
+            ax[k].plot(tt, scale * r0, "k", lw=1, label=f"without dampers (rms {scale * rms(y0):.3g} {unit})")
+            ax[k].plot(tt, scale * r1, "C0", lw=1.2, label=f"with TLD.fmu (rms {scale * rms(y1):.3g} {unit}, "
+                                                           f"{100 * (1 - rms(y1) / rms(y0)):.0f} % less)")
+            ax[k].set_ylim(bottom=0)
+        ax[1].set_ylabel("roof displ.,\n10 s running rms [mm]")
+        ax[3].set_ylabel("roof acc.,\n10 s running rms [m/s2]")
+        i = int(np.argmax(np.abs(bare["X"][:, -1])))
+        lo = max(0.0, min(t[i] - 10.0, t[-1] - 20.0))
+        w = (t >= lo) & (t <= lo + 20.0)
+        ax[1].axvspan(lo, lo + 20.0, color="C1", alpha=0.15, label="the window below")
+        ax[2].plot(t[w], 1e3 * bare["X"][w, -1], "k", lw=0.8, label="without dampers")
+        ax[2].plot(t[w], 1e3 * s["X"][w, -1], "C0", lw=0.8, label="with TLD.fmu")
+        ax[2].set_xlim(lo, lo + 20.0)
+        ax[2].set_ylabel("roof displ. [mm]")
+        ax[2].set_title(f"{lo:.0f}-{lo + 20:.0f} s, around the bare building's largest roof displacement",
+                        fontsize=9)
+        ax[2].set_xlabel("t [s]")
+        ax[4].plot(t, s["E"])
+        ax[4].set_ylabel("dissipated by\nthe dampers [J]")
+        ax[4].sharex(ax[1])
+        ax[3].sharex(ax[1])
+        for a_ in (ax[1], ax[3]):
+            a_.tick_params(labelbottom=False)
+    else:
+        for a_ in ax[2:]:
+            a_.sharex(ax[1])
+        ax[1].plot(bare["t"], bare["X"][:, -1] * 1e3, "k", lw=0.6, label="without dampers")
+        ax[1].plot(t, s["X"][:, -1] * 1e3, "C0", lw=0.6,
+                   label=f"with TLD.fmu ({less(s['X'][:, -1], bare['X'][:, -1])})")
+        ax[1].set_ylabel("roof displ. [mm]")
+        ax[2].plot(bare["t"], bare["A"][:, -1], "k", lw=0.6, label="without dampers")
+        ax[2].plot(t, s["A"][:, -1], "C0", lw=0.6,
+                   label=f"with TLD.fmu (rms {rms(bare['A'][:, -1]):.3f} -> {rms(s['A'][:, -1]):.3f} m/s2, "
+                         f"{100 * (1 - rms(s['A'][:, -1]) / rms(bare['A'][:, -1])):.0f} % less)")
+        ax[2].set_ylabel("roof acc. [m/s2]")
+        ax[3].plot(t, s["F"], lw=0.6)
+        ax[3].set_ylabel("damper force [N]")
+        ax[4].plot(t, s["E"])
+        ax[4].set_ylabel("dissipated [J]")
+        for a_ in ax[1:4]:
+            a_.tick_params(labelbottom=False)
     for a_ in ax[1:4]:
-        a_.tick_params(labelbottom=False)
+        if a_.get_legend_handles_labels()[0]:
+            a_.legend(loc="upper right", fontsize=7)
+    ax[4].set_xlabel("t [s]")
     fig.suptitle(f"{len(s['X'][0])}-storey building under {'wind-like random floor forces' if kind == 'wind' else 'a ground-motion record'}: "
                  f"with and without TLD.fmu", fontsize=10)
     fig.tight_layout(); fig.savefig(out / f"{kind}.png", dpi=120)
