@@ -39,9 +39,11 @@ def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: s
         ratios = sorted({r["mass_ratio"] for r in mine})
         Z = np.full((len(ratios), len(tunings)), np.nan)
         edge = np.zeros_like(Z, dtype=bool)
+        flag = np.zeros_like(Z, dtype=bool)
         for r in mine:
             i, j = ratios.index(r["mass_ratio"]), tunings.index(r["tuning"])
             Z[i, j], edge[i, j] = r["peak_amplification"], not r["bounded"]
+            flag[i, j] = bool(r.get("plausibility"))
         im = ax.imshow(Z, origin="lower", aspect="auto", cmap="viridis", vmin=vmin, vmax=vmax)
         # every other tuning labelled when there are many: the labels never touch
         ax.set_xticks(range(len(tunings)), [f"{t:g}" if not small or j % 2 == 0 else "" for j, t in enumerate(tunings)],
@@ -49,7 +51,7 @@ def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: s
         ax.set_yticks(range(len(ratios)), [f"{100 * m:.2g} %" for m in ratios], fontsize=8)
         mid = (vmin + vmax) / 2 if vals else 0
         for i, j in itertools.product(range(len(ratios)), range(len(tunings))):
-            text = f"{Z[i, j]:.0f}" + ("*" if edge[i, j] else "")
+            text = f"{Z[i, j]:.0f}" + ("*" if edge[i, j] else "") + ("!" if flag[i, j] else "")
             if bare and not small:
                 text += f"\n{100 * (1 - Z[i, j] / bare):.0f} % less"
             # dark text on the light (high) cells, white on the dark ones
@@ -67,7 +69,8 @@ def heat_maps(peaks: list[dict], path: Path, zeta: float | None = None, title: s
     ref = (f"without dampers {bare:.0f} (closed form 1/(2 zeta sqrt(1 - zeta^2)), zeta = {100 * zeta:g} %)"
            if bare else "")
     fig.suptitle(f"{head}peak amplification over frequency, refined; {ref}\n"
-                 "* = at the edge of the frequency range (the peak may lie outside)", fontsize=9)
+                 "* = at the edge of the frequency range (the peak may lie outside); "
+                 "! = implausible (sweep.py's plausibility column)", fontsize=9)
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
 
@@ -84,7 +87,7 @@ def best_tuning(peaks: list[dict], path: Path, zeta: float | None = None, title:
     ratios = sorted({r["mass_ratio"] for r in peaks})
     fig, panels = plt.subplots(1, len(combos), figsize=(4.4 * len(combos) + 1.0, 4.2 + 0.22 * len(amps)),
                                sharey=True, squeeze=False)
-    top = 0.0
+    top, flagged = 0.0, False
     for ci, combo in enumerate(combos):
         ax = panels[0][ci]
         table = []
@@ -104,8 +107,14 @@ def best_tuning(peaks: list[dict], path: Path, zeta: float | None = None, title:
             top = max(top, *ys)
             ax.plot([100 * m for m in ms], ys, ["o", "s", "^", "D"][ai % 4] + "-", color=f"C{ai}", ms=5,
                     label=f"ground amplitude {amp * 1e3:g} mm")
+            bad = [m for m in ms if best[m].get("plausibility")]
+            if bad:
+                ax.plot([100 * m for m in bad], [best[m]["peak_amplification"] for m in bad], "x", color="C3",
+                        ms=10, mew=2, label="implausible (sweep.py's plausibility column)" if not flagged else None)
+                flagged = True
         what = ", ".join(f"{a} {v}" for a, v in zip(axes, combo))
-        ax.set_title(what or "best tuning", fontsize=10)
+        if what:
+            ax.set_title(what, fontsize=10)
         ax.set_xticks([100 * m for m in ratios], [f"{100 * m:g}" for m in ratios])
         ax.set_xlabel("mass ratio [%]")
         ax.grid(alpha=0.3)
@@ -125,6 +134,6 @@ def best_tuning(peaks: list[dict], path: Path, zeta: float | None = None, title:
     fig.suptitle(f"{title + ': ' if title else ''}the best tuning of each mass ratio, refined peaks{bare}\n"
                  "tables: the tuning omega_f / omega_s that reaches each point, per ground amplitude and mass ratio",
                  fontsize=10)
-    fig.subplots_adjust(top=0.86, wspace=0.3)
+    fig.subplots_adjust(top=1 - 0.85 / fig.get_figheight(), wspace=0.3)
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
