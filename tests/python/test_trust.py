@@ -192,7 +192,7 @@ def test_documented_writers_default_to_out():
     assert "\ndest=out/calibration\n" in report and "--docs) dest=docs" in report
     fig25 = (REPO / "scripts" / "fig25.py").read_text()
     assert 'REPO / "docs" if args.docs else Path(args.out)' in fig25
-    assert "[QUICK_NOTE.format(duration=duration)] if args.quick else [COMPARISON]" in fig25
+    assert "[QUICK_NOTE.format(" in fig25 and "if args.quick else [COMPARISON]" in fig25
 
 
 def test_freqresp_coupled_prints_a_table(tmp_path):
