@@ -211,6 +211,28 @@ def test_freqresp_coupled_prints_a_table(tmp_path):
     assert run("git", "status", "--porcelain").stdout == status
 
 
+def test_calibrate_draws_smooth_curves_and_writes_only_out():
+    """scripts/calibrate (the NSD laws): the plot's curves on 81 values of Lambda, which meet the
+    fit's own values at the samples' ends; nothing tracked is written."""
+    if not (REPO / "target" / "release" / "tld-calibrate").is_file():
+        pytest.skip("tld-calibrate not built (scripts/calibrate builds it on its first run)")
+    status = run("git", "status", "--porcelain").stdout
+    r = run("scripts/calibrate")
+    assert r.returncode == 0, r.stderr
+    assert "wrote out/calibration.png" in r.stdout and "scripts/calibrate: " in r.stdout
+    import numpy as np
+    from tld_fmu.calibration import read_curve, read_fit
+    curve = read_curve(REPO / "out" / "calibration_curve.csv")
+    _, d = read_fit(REPO / "out" / "calibration.csv")
+    assert len(curve["lambda"]) == 81
+    for i, j in ((0, 0), (-1, -1)):
+        assert curve["lambda"][i] == pytest.approx(d["lambda"][j], rel=1e-12)
+        for q in ("kappa_model", "zeta_model", "kappa_nsd", "zeta_nsd"):
+            assert curve[q][i] == pytest.approx(d[q][j], rel=1e-9), q
+    assert np.all(np.diff(curve["lambda"]) > 0)
+    assert run("git", "status", "--porcelain").stdout == status
+
+
 def test_summary_of_nothing_says_none():
     assert fmulog.Report().summary() == ["warnings: none (FMU and configuration)"]
     buf = io.StringIO()
