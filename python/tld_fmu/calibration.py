@@ -80,7 +80,7 @@ def plot(csv_path: Path, png: Path, title: str, sweeps_path: Path | None = None,
               f"Nonlinear model fitted: phi = {fit['phi']:.3g}, eta = {fit['eta']:.3g}",
               "NSD law (fit of experiments)", "kappa = jump frequency / w_f")
     fit_panel(axes[1], "loglog", "zeta", f"zeta = {fit['nsd_c']:.3g} Lambda^{fit['nsd_p']:.3g} fitted",
-              "NSD law: 0.5 Lambda^0.35", "zeta = damping ratio (shallow-water data: energy-equivalent)",
+              "NSD law: 0.5 Lambda^0.35", "zeta = damping ratio",
               which="both")
     if sweeps:
         a3 = axes[2]
