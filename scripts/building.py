@@ -18,6 +18,7 @@ import multiprocessing as mp
 import os
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +43,7 @@ def main(argv=None):
                     help=f"run a configuration refused as implausible (water mass above "
                          f"{fmulog.MASS_RATIO_MAX:g} of the modal mass); its results are flagged")
     args = ap.parse_args(argv)
+    t_start = time.perf_counter()
     from fmpy import extract, read_model_description
     from tqdm import tqdm
     import matplotlib
@@ -82,6 +84,7 @@ def main(argv=None):
         write_histories(out, load["kind"], runs[True], runs[False], plt)
     else:
         sys.exit(f"unknown load kind {load['kind']!r}: harmonic, record or wind")
+    print(f"wall time {time.perf_counter() - t_start:.0f} s")
     fmulog.REPORT.print_summary()
 
 

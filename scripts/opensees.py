@@ -23,6 +23,7 @@ damper's force and its dissipated energy against the storeys' hysteretic energy,
 out/opensees/ (quake.png, quake.csv)."""
 import argparse
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -58,6 +59,7 @@ def main(argv=None):
                     help=f"run a configuration refused as implausible (water mass above "
                          f"{fmulog.MASS_RATIO_MAX:g} of the modal mass); its results are flagged")
     args = ap.parse_args(argv)
+    t_start = time.perf_counter()
     from fmpy import extract, read_model_description
     import matplotlib
     matplotlib.use("Agg")
@@ -77,6 +79,7 @@ def main(argv=None):
         verify(cfg, unzipdir, md, out, plt)
     else:
         quake(cfg, unzipdir, md, out, plt, args)
+    print(f"wall time {time.perf_counter() - t_start:.0f} s")
     fmulog.REPORT.print_summary()
 
 
