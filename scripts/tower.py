@@ -24,14 +24,15 @@ import math
 import sys
 import tempfile
 import time
-import tomllib
 from pathlib import Path
 
 import numpy as np
 
-from tld_fmu import building, opensees
+from tld_fmu import building, fmulog, opensees
+from tld_fmu.contract import Contract
 from tld_fmu.machine import git_info, machine_line
 from tld_fmu.paths import BUILDING_FMU, FMU, REPO
+from tld_fmu.studyfile import StudyError, load_building
 
 G = 9.80665
 CALIBRATED = {"phi": 2.71, "eta": 1.86}    # tld-calibrate's fit to the NSD hardening law
@@ -130,7 +131,7 @@ def ssp_runs(cfg, h, steps, tmp, hosts, desc, ground=None, forces=None):
     outputs = [f"Building.floor[{i}].x" for i in range(1, n + 1)] + [f"Building.floor[{n}].a"]
     runs = {}
     from tqdm import tqdm
-    for host in tqdm(hosts, desc=desc):
+    for host in tqdm(hosts, desc=desc, disable=None):
         r = ssp.HOSTS[host](path, h, steps, outputs, a, inputs)
         X = np.column_stack([r[f"Building.floor[{i}].x"] for i in range(1, n + 1)])
         A = np.zeros_like(X)
@@ -165,15 +166,19 @@ def main(argv=None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     started = time.time()
-    cfg = tomllib.loads(Path(args.config).read_text())
+    md = read_model_description(str(FMU))
+    try:   # every problem of the file at once, misspelt names with the closest valid ones
+        cfg = load_building(Path(args.config), Contract(md))
+    except StudyError as e:
+        sys.exit(f"scripts/tower.py: {e}")
     if len(cfg.get("dampers", [])) != 1:
         sys.exit(f"{args.config}: the tower example has one [[dampers]] entry (its tanks on one level)")
     out = REPO / "docs" if args.docs else Path(args.out)
     figs = out / "fullscale" if args.docs else out
     figs.mkdir(parents=True, exist_ok=True)
-    md = read_model_description(str(FMU))
     tmp = tempfile.mkdtemp(prefix="tower_")
     unzipdir = extract(str(FMU), tmp + "/tld")
+    building.check_plausible(cfg, unzipdir, md, prog="scripts/tower.py")   # refuses an implausible water mass
     d = design(cfg, unzipdir, md)
     h = cfg["coupling"]["step"]
     derivs = bool(cfg["coupling"].get("derivatives", False))
@@ -198,10 +203,10 @@ def main(argv=None):
                 "BoundaryLayer damping": (with_params(cfg, damping="BoundaryLayer"), True),
                 "phi 2.71, eta 1.86": (with_params(cfg, **CALIBRATED), True)}
     wind = {}
-    for name, (c, damped) in tqdm(list(variants.items()), desc="wind, own master"):
+    for name, (c, damped) in tqdm(list(variants.items()), desc="wind, own master", disable=None):
         wind[("own", name)] = building.simulate(c, unzipdir, md, lambda t: (0.0, 0.0, 0.0), h, T_wind,
                                                 with_dampers=damped, floor_forces=forces, derivatives=derivs)
-    for damped in tqdm((False, True), desc="wind, OpenSees"):
+    for damped in tqdm((False, True), desc="wind, OpenSees", disable=None):
         wind[("OpenSees", "with tanks" if damped else "without tanks")] = opensees.simulate(
             cfg, unzipdir, md, lambda t: (0.0, 0.0, 0.0), h, T_wind, with_dampers=damped,
             derivatives=derivs and damped, floor_forces=forces)
@@ -220,11 +225,11 @@ def main(argv=None):
     T_q = float(np.floor(t_rec[-1] / h) * h)
     qsteps = int(round(T_q / h))
     quake = {}
-    for name in tqdm(("without tanks", "with tanks", "phi 2.71, eta 1.86"), desc="earthquake, own master"):
+    for name in tqdm(("without tanks", "with tanks", "phi 2.71, eta 1.86"), desc="earthquake, own master", disable=None):
         c = with_params(cfg, **CALIBRATED) if name.startswith("phi") else cfg
         quake[("own", name)] = building.simulate(c, unzipdir, md, ground, h, T_q, with_dampers=name != "without tanks",
                                                  derivatives=derivs)
-    for damped in tqdm((False, True), desc="earthquake, OpenSees"):
+    for damped in tqdm((False, True), desc="earthquake, OpenSees", disable=None):
         quake[("OpenSees", "with tanks" if damped else "without tanks")] = opensees.simulate(
             cfg, unzipdir, md, ground, h, T_q, with_dampers=damped, derivatives=derivs and damped)
     for host, r in ssp_runs(cfg, h, qsteps, tmp, SSP_HOSTS, "earthquake, SSP", ground=ground).items():
@@ -244,6 +249,7 @@ def main(argv=None):
     (out / ("summary.json" if not args.docs else "fullscale/summary.json")).write_text(json.dumps(summary, indent=1))
     report(summary, wind, quake, ws, qs, out, figs, args, plt)
     print(f"wrote {out / 'FULLSCALE.md' if args.docs else out}; {elapsed:.0f} s")
+    fmulog.REPORT.print_summary()
 
 
 def table(columns, pairs):

@@ -35,8 +35,16 @@ def run_libcosim(ssp: Path, h: float, steps: int, outputs, ground_a=None, inputs
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimManipulator import CosimManipulator
     from libcosimpy.CosimObserver import CosimObserver
-    log_output_level(CosimLogLevel.WARNING)
-    ex = CosimExecution.from_ssp_file(str(Path(ssp).resolve()), round(h * 1e9))
+    # Loading, libcosim warns once per Enumeration variable of TLD.fmu (model, damping, amplitude,
+    # solver: "FMI 2.0 Enumeration variable type not supported ... will be ignored"). Nothing is
+    # lost: the archive sets those parameters through their Integer aliases (model_id, ...), which
+    # libcosim handles. Those four lines are all it says while loading these archives, so the load
+    # runs at level error; the run itself at warning.
+    log_output_level(CosimLogLevel.ERROR)
+    try:
+        ex = CosimExecution.from_ssp_file(str(Path(ssp).resolve()), round(h * 1e9))
+    finally:
+        log_output_level(CosimLogLevel.WARNING)
     index = {s.name.decode(): s.index for s in ex.slave_infos()}
     vr = {name: {v.name.decode(): v.reference for v in ex.slave_variables(i)} for name, i in index.items()}
     man, obs = CosimManipulator.create_override(), CosimObserver.create_last_value()
