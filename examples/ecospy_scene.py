@@ -1,4 +1,4 @@
-# TLD.fmu in Ecos (ecospy): the README's scene; inputs set between steps are passed on just
+# TLD.fmu in Ecos (ecospy): the scene of docs/USING.md; inputs set between steps are passed on just
 # before the next fmi2DoStep. Needs the `tbb` wheel (libtbb.so.12) and `unzip` on PATH.
 # From the repository root, after scripts/package:  .venv/bin/python examples/ecospy_scene.py [seconds]
 import ctypes

@@ -1,4 +1,4 @@
-# TLD.fmu in fmpy: harmonic base motion near resonance, 0.01 s steps (the README's scene).
+# TLD.fmu in fmpy: harmonic base motion near resonance, 0.01 s steps (the scene of docs/USING.md).
 # From the repository root, after scripts/package:  .venv/bin/python examples/fmpy_scene.py [seconds]
 import os
 import sys

@@ -1,4 +1,4 @@
-# TLD.fmu in libcosim (libcosimpy): the README's scene as a fixed-step execution; the input goes
+# TLD.fmu in libcosim (libcosimpy): the scene of docs/USING.md as a fixed-step execution; the input goes
 # in through an override manipulator before each step, the outputs come from a last-value observer.
 # From the repository root, after scripts/package:  .venv/bin/python examples/libcosimpy_scene.py [seconds]
 import os

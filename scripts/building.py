@@ -18,13 +18,16 @@ import multiprocessing as mp
 import os
 import sys
 import tempfile
-import tomllib
+import time
 from pathlib import Path
 
 import numpy as np
 
+from tld_fmu import fmulog
 from tld_fmu import peaks as pk
-from tld_fmu.building import Building, harmonic_ground, record_ground, simulate, wind_forces
+from tld_fmu.building import Building, check_plausible, harmonic_ground, record_ground, simulate, wind_forces
+from tld_fmu.contract import Contract
+from tld_fmu.studyfile import StudyError, load_building
 from tld_fmu.paths import FMU, REPO
 
 
@@ -36,15 +39,25 @@ def main(argv=None):
     ap.add_argument("--xtol", type=float, default=2e-3,
                     help="harmonic sweep: tolerance of the refined peak frequencies, in w/w_1 (default 0.002)")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: one per core)")
+    ap.add_argument("--force", action="store_true",
+                    help=f"run a configuration refused as implausible (water mass above "
+                         f"{fmulog.MASS_RATIO_MAX:g} of the modal mass); its results are flagged")
     args = ap.parse_args(argv)
-    cfg = tomllib.loads(Path(args.config).read_text())
+    t_start = time.perf_counter()
     from fmpy import extract, read_model_description
     from tqdm import tqdm
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    if not Path(args.fmu).is_file():
+        raise SystemExit(f"{args.fmu} not found: run scripts/package first")
     md = read_model_description(args.fmu)
+    try:
+        cfg = load_building(Path(args.config), Contract(md))
+    except StudyError as e:
+        raise SystemExit(f"scripts/building.py: {e}") from None
     unzipdir = extract(args.fmu, tempfile.mkdtemp())
+    check_plausible(cfg, unzipdir, md, args.force)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     load, h = cfg["load"], cfg["coupling"]["step"]
@@ -65,12 +78,14 @@ def main(argv=None):
                                     load.get("band", [0.02, 5.0]), load.get("corner", 0.1),
                                     load.get("coherence", 0.5), load.get("seed", 1))
         runs = {}
-        for damped in tqdm((False, True), desc=load["kind"]):
+        for damped in tqdm((False, True), desc=load["kind"], disable=None):
             runs[damped] = simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=damped,
                                    floor_forces=forces, derivatives=derivs)
         write_histories(out, load["kind"], runs[True], runs[False], plt)
     else:
         sys.exit(f"unknown load kind {load['kind']!r}: harmonic, record or wind")
+    print(f"wall time {time.perf_counter() - t_start:.0f} s")
+    fmulog.REPORT.print_summary()
 
 
 _RUN = {}   # what the sweep's worker processes need (set before the pool forks)
@@ -83,7 +98,18 @@ def _roof_peak(job):
     s = simulate(cfg, unzipdir, md, harmonic_ground(r * w1, load["ground_amplitude"]), h, load["duration"],
                  with_dampers=damped, derivatives=derivs)
     tail = s["t"] > load["duration"] - 20.0
-    return float(np.max(np.abs(s["X"][tail, -1])))
+    # the FMU's warnings go back to the parent, which shows them (a worker's line would land in
+    # the parent's progress bar)
+    return float(np.max(np.abs(s["X"][tail, -1]))), fmulog.REPORT.drain()
+
+
+def _peaks(results):
+    """The peaks of _roof_peak's results; their warnings merged into this process's report."""
+    out = []
+    for peak, warned in results:
+        fmulog.REPORT.merge(warned)
+        out.append(peak)
+    return out
 
 
 def sweep(cfg, unzipdir, md, out, args, plt):
@@ -101,14 +127,14 @@ def sweep(cfg, unzipdir, md, out, args, plt):
                 derivs=bool(cfg["coupling"].get("derivatives", False)))
     ratios = np.linspace(load["from"], load["to"], load["points"])
     jobs = [(damped, float(r)) for r in ratios for damped in (False, True)]
-    with mp.get_context("fork").Pool(max(1, min(args.jobs, len(jobs)))) as pool:
-        got = list(tqdm(pool.imap(_roof_peak, jobs), total=len(jobs), desc="sweep grid"))
+    with mp.get_context("fork").Pool(max(1, min(args.jobs, len(jobs))), initializer=fmulog.quiet_worker) as pool:
+        got = _peaks(tqdm(pool.imap(_roof_peak, jobs), total=len(jobs), desc="sweep grid", disable=None))
         grid = {False: np.array(got[0::2]), True: np.array(got[1::2])}
-        bar = tqdm(desc="peak refinement runs")
+        bar = tqdm(desc="peak refinement runs", disable=None)
 
         def evaluate(batch):
             bar.update(len(batch))
-            return pool.map(_roof_peak, batch)
+            return _peaks(pool.map(_roof_peak, batch))
 
         found = pk.refine_curves({d: (ratios, grid[d]) for d in (False, True)}, evaluate, args.xtol)
         bar.close()
@@ -177,8 +203,6 @@ def write_histories(out, kind, s, bare, plt):
     bare_drift = np.diff(np.column_stack([np.zeros(len(bare["t"])), bare["X"]]), axis=1)
     less = lambda a, b: f"rms {1e3 * rms(b):.2f} -> {1e3 * rms(a):.2f} mm, {100 * (1 - rms(a) / rms(b)):.0f} % less"  # noqa: E731
     fig, ax = plt.subplots(5, 1, figsize=(9, 12), gridspec_kw={"height_ratios": [1.2, 1, 1, 1, 1]})
-    for a_ in ax[2:]:
-        a_.sharex(ax[1])
     # storey drifts: rms and peak per storey, without and with the dampers (a time history of
     # several storeys on top of each other hides the reduction)
     storeys = np.arange(1, drift.shape[1] + 1)
@@ -194,23 +218,73 @@ def write_histories(out, kind, s, bare, plt):
                        (storeys[i], 1e3 * max(p0, p1)), textcoords="offset points", xytext=(0, 8), ha="center",
                        fontsize=8)
     ax[0].set_xticks(storeys, [f"storey {i}" for i in storeys])
-    ax[0].set_xlim(0.4, drift.shape[1] + 1.6)
+    ax[0].set_xlim(0.4, drift.shape[1] + 0.6)
     ax[0].set_ylim(0, 1.45e3 * max(peak(bare_drift), peak(drift)))
-    ax[0].set_ylabel("storey drift [mm]"); ax[0].legend(loc="upper right", fontsize=7)
+    ax[0].set_ylabel("storey drift [mm]")
+    ax[0].legend(fontsize=7, ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.12), frameon=False)
     ax[0].set_title("storey drifts over the whole run", fontsize=9)
-    ax[1].plot(bare["t"], bare["X"][:, -1] * 1e3, "k", lw=0.6, label="without dampers")
-    ax[1].plot(s["t"], s["X"][:, -1] * 1e3, "C0", lw=0.6,
-               label=f"with TLD.fmu ({less(s['X'][:, -1], bare['X'][:, -1])})")
-    ax[1].set_ylabel("roof displ. [mm]"); ax[1].legend(loc="upper right", fontsize=7)
-    ax[2].plot(bare["t"], bare["A"][:, -1], "k", lw=0.6, label="without dampers")
-    ax[2].plot(s["t"], s["A"][:, -1], "C0", lw=0.6,
-               label=f"with TLD.fmu (rms {rms(bare['A'][:, -1]):.3f} -> {rms(s['A'][:, -1]):.3f} m/s2, "
-                     f"{100 * (1 - rms(s['A'][:, -1]) / rms(bare['A'][:, -1])):.0f} % less)")
-    ax[2].set_ylabel("roof acc. [m/s2]"); ax[2].legend(loc="upper right", fontsize=7)
-    ax[3].plot(s["t"], s["F"], lw=0.6); ax[3].set_ylabel("damper force [N]")
-    ax[4].plot(s["t"], s["E"]); ax[4].set_ylabel("dissipated [J]"); ax[4].set_xlabel("t [s]")
+    t = s["t"]
+    long = t[-1] > 60.0
+    if long:
+        # a long record's oscillations fill the panel solid: the running rms over 10 s shows how
+        # the response evolves, and a 20 s window around the bare building's largest roof
+        # displacement shows the oscillations themselves
+        n = max(1, int(round(10.0 / (t[1] - t[0]))))
+
+        def running(y):
+            c = np.concatenate([[0.0], np.cumsum(y * y)])
+            out = np.sqrt((c[n:] - c[:-n]) / n)
+            return t[n // 2:n // 2 + len(out)], out
+
+        for y0, y1, unit, scale, k in ((bare["X"][:, -1], s["X"][:, -1], "mm", 1e3, 1),
+                                       (bare["A"][:, -1], s["A"][:, -1], "m/s2", 1.0, 3)):
+            tt, r0 = running(y0)
+            _, r1 = running(y1)
+            ax[k].plot(tt, scale * r0, "k", lw=1, label=f"without dampers (rms {scale * rms(y0):.3g} {unit})")
+            ax[k].plot(tt, scale * r1, "C0", lw=1.2, label=f"with TLD.fmu (rms {scale * rms(y1):.3g} {unit}, "
+                                                           f"{100 * (1 - rms(y1) / rms(y0)):.0f} % less)")
+            ax[k].set_ylim(bottom=0)
+        ax[1].set_ylabel("roof displ.,\n10 s running rms [mm]")
+        ax[3].set_ylabel("roof acc.,\n10 s running rms [m/s2]")
+        i = int(np.argmax(np.abs(bare["X"][:, -1])))
+        lo = max(0.0, min(t[i] - 10.0, t[-1] - 20.0))
+        w = (t >= lo) & (t <= lo + 20.0)
+        ax[1].axvspan(lo, lo + 20.0, color="C1", alpha=0.15, label="the window below")
+        ax[2].plot(t[w], 1e3 * bare["X"][w, -1], "k", lw=0.8, label="without dampers")
+        ax[2].plot(t[w], 1e3 * s["X"][w, -1], "C0", lw=0.8, label="with TLD.fmu")
+        ax[2].set_xlim(lo, lo + 20.0)
+        ax[2].set_ylabel("roof displ. [mm]")
+        ax[2].set_title(f"{lo:.0f}-{lo + 20:.0f} s, around the bare building's largest roof displacement",
+                        fontsize=9)
+        ax[2].set_xlabel("t [s]")
+        ax[4].plot(t, s["E"])
+        ax[4].set_ylabel("dissipated by\nthe dampers [J]")
+        ax[4].sharex(ax[1])
+        ax[3].sharex(ax[1])
+        for a_ in (ax[1], ax[3]):
+            a_.tick_params(labelbottom=False)
+    else:
+        for a_ in ax[2:]:
+            a_.sharex(ax[1])
+        ax[1].plot(bare["t"], bare["X"][:, -1] * 1e3, "k", lw=0.6, label="without dampers")
+        ax[1].plot(t, s["X"][:, -1] * 1e3, "C0", lw=0.6,
+                   label=f"with TLD.fmu ({less(s['X'][:, -1], bare['X'][:, -1])})")
+        ax[1].set_ylabel("roof displ. [mm]")
+        ax[2].plot(bare["t"], bare["A"][:, -1], "k", lw=0.6, label="without dampers")
+        ax[2].plot(t, s["A"][:, -1], "C0", lw=0.6,
+                   label=f"with TLD.fmu (rms {rms(bare['A'][:, -1]):.3f} -> {rms(s['A'][:, -1]):.3f} m/s2, "
+                         f"{100 * (1 - rms(s['A'][:, -1]) / rms(bare['A'][:, -1])):.0f} % less)")
+        ax[2].set_ylabel("roof acc. [m/s2]")
+        ax[3].plot(t, s["F"], lw=0.6)
+        ax[3].set_ylabel("damper force [N]")
+        ax[4].plot(t, s["E"])
+        ax[4].set_ylabel("dissipated [J]")
+        for a_ in ax[1:4]:
+            a_.tick_params(labelbottom=False)
     for a_ in ax[1:4]:
-        a_.tick_params(labelbottom=False)
+        if a_.get_legend_handles_labels()[0]:
+            a_.legend(loc="upper right", fontsize=7)
+    ax[4].set_xlabel("t [s]")
     fig.suptitle(f"{len(s['X'][0])}-storey building under {'wind-like random floor forces' if kind == 'wind' else 'a ground-motion record'}: "
                  f"with and without TLD.fmu", fontsize=10)
     fig.tight_layout(); fig.savefig(out / f"{kind}.png", dpi=120)

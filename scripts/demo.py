@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tld_fmu import fmulog
 from tld_fmu import peaks as pk
 from tld_fmu.paths import FMU, REPO
 from tld_fmu.sdof import M_S, W_S, ZETA_S, bare_structure_peak, run_one
@@ -73,17 +74,20 @@ def main(argv=None):
                 for r in ratios]
         t0 = time.time()
         results = []
-        with mp.get_context("spawn").Pool(max(1, min(args.jobs, len(jobs)))) as pool:
+        with mp.get_context("spawn").Pool(max(1, min(args.jobs, len(jobs))), initializer=fmulog.quiet_worker) as pool:
             for r in tqdm(pool.imap_unordered(run_one, jobs), total=len(jobs),
-                          desc="frequencies", unit="run", file=sys.stderr):
+                          desc="frequencies", unit="run", file=sys.stderr, disable=None):
+                fmulog.REPORT.merge(r["warnings"])
                 results.append(r)
             results.sort(key=lambda r: r["w"])
-            bar = tqdm(desc="peak refinement", unit="run", file=sys.stderr)
+            bar = tqdm(desc="peak refinement", unit="run", file=sys.stderr, disable=None)
             extra = []
 
             def evaluate(batch):
                 got = pool.map(run_one, [(unzipdir, x * W_S, args.ground, args.step, args.duration,
                                           args.window) for _, x in batch])
+                for g in got:
+                    fmulog.REPORT.merge(g["warnings"])
                 extra.extend(got)
                 bar.update(len(batch))
                 return [g["with"] for g in got]
@@ -186,6 +190,7 @@ def main(argv=None):
     fig.tight_layout()
     fig.savefig(out)
     print(f"wrote {out}")
+    fmulog.REPORT.print_summary()
 
 
 if __name__ == "__main__":

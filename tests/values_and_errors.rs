@@ -237,6 +237,20 @@ fn out_of_range_and_inconsistent_parameters() {
         inst.logs()
     );
     assert_eq!(inst.set_real(vr::SLAMMING_CLEARANCE, 0.1), OK);
+    // Screens: 17 screens are out of range; three screens 0.2 m apart do not fit a 0.25 m tank
+    // (refused at exit, the reason logged); a pair 0.05 m apart does.
+    assert_eq!(inst.set_integer(vr::SCREENS_COUNT, 17), ERROR);
+    assert_eq!(inst.set_real(vr::SCREENS_SOLIDITY, 0.99), ERROR);
+    assert_eq!(inst.set_integer(vr::SCREENS_COUNT, 3), OK);
+    assert_eq!(inst.set_real(vr::SCREENS_SPACING, 0.2), OK);
+    assert_eq!(inst.exit(), ERROR);
+    assert!(
+        inst.logs().iter().any(|m| m.contains("screens.spacing")),
+        "{:?}",
+        inst.logs()
+    );
+    assert_eq!(inst.set_integer(vr::SCREENS_COUNT, 2), OK);
+    assert_eq!(inst.set_real(vr::SCREENS_SPACING, 0.05), OK);
     assert_eq!(inst.exit(), OK);
 }
 

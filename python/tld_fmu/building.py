@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from . import fmulog
 from .contract import Contract
 
 
@@ -154,7 +155,8 @@ class Damper:
         self.var = self.contract.variables
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
-        self.fmu.instantiate()
+        self._callbacks = fmulog.callbacks()   # its warnings reach fmulog.REPORT, on their own lines
+        self.fmu.instantiate(callbacks=self._callbacks)
         vr = lambda n: self.var[n].valueReference  # noqa: E731
         f = self.fmu._functions
         self._set, self._get, self._step = f["fmi2SetReal"], f["fmi2GetReal"], f["fmi2DoStep"]
@@ -330,3 +332,25 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, floor_fo
             dp.close()
     out["omega1"] = bld.omega1
     return out
+
+
+def check_plausible(cfg, unzipdir, md, force=False, prog="scripts/building.py"):
+    """Refuse (SystemExit, unless force) a building whose dampers' water is more than
+    fmulog.MASS_RATIO_MAX of the modal mass, and flag (fmulog.REPORT) dampers whose sloshing
+    frequency is outside fmulog.TUNING_BAND of the structure's nearest mode. Each damper is
+    instantiated once here, so its configuration warnings reach fmulog.REPORT before any run."""
+    b, found = cfg["building"], []
+    for k, d in enumerate(cfg.get("dampers", [])):
+        dp = Damper(unzipdir, md, d["floor"], d.get("tanks", 1), d.get("params", {}), f"tld{k}")
+        w_f, m = dp.fmu.getReal([dp.var[n].valueReference for n in ("omega_f", "mass.liquid")])
+        dp.close()
+        found.append((d["floor"], m, w_f))
+    refuse, flag = fmulog.plausible_dampers(b["masses"], b["stiffnesses"], found)
+    for f in flag:
+        fmulog.REPORT.add("implausible configuration", f)
+    if refuse and not force:
+        lines = "\n".join(f"  {r}" for r in refuse + flag)
+        raise SystemExit(f"{prog}: refused, an implausible configuration:\n{lines}\n"
+                         f"(--force runs it anyway; its results are then flagged)")
+    for r in refuse:
+        fmulog.REPORT.add("implausible configuration (run with --force)", r)

@@ -3,7 +3,14 @@
 tld-calibrate writes the samples with the fit (`--csv`: a `# phi=...` comment line, then
 lambda,kappa_data,kappa_model,zeta_data,zeta_model,kappa_nsd,zeta_nsd) and, for the shallow-water
 source, every swept point (`--sweeps`: lambda,direction,ratio,x,phase,x_peak,zeta_eq,cycles,settled,jump; jump = 1 on
-the last point before a sweep's jump, as tld-calibrate finds it).
+the last point before a sweep's jump, as tld-calibrate finds it) and, with `--curve`, the fitted
+model and the NSD laws on a fine grid of Lambda (lambda,kappa_model,zeta_model,kappa_nsd,zeta_nsd),
+drawn as the plot's curves.
+
+kappa is the jump frequency over w_f as docs/MODEL.md defines it: where a slow up-sweep falls
+off the upper branch of the response. The shallow-water source measures it where the up-sweep's
+response is in quadrature with the excitation (that point, the top of the upper branch when the
+sweep jumps; the equivalent linear resonance when it does not).
 """
 from __future__ import annotations
 
@@ -32,10 +39,17 @@ def read_sweeps(path: Path) -> list[dict]:
                 for r in csv.DictReader(fh)]
 
 
+def read_curve(path: Path) -> dict[str, np.ndarray]:
+    """The columns of a --curve file."""
+    data = np.genfromtxt(path, delimiter=",", names=True)
+    return {k: data[k] for k in data.dtype.names}
+
+
 def plot(csv_path: Path, png: Path, title: str, sweeps_path: Path | None = None,
-         length: float | None = None) -> None:
-    """kappa(Lambda) and zeta(Lambda): the data, the fitted model and the NSD laws; with the
-    sweeps, a third panel with the swept response curves (amplitude over the tank half-length)."""
+         length: float | None = None, curve_path: Path | None = None) -> None:
+    """kappa(Lambda) and zeta(Lambda): the data, the fitted model and the NSD laws (smooth
+    curves from curve_path; else lines through the samples); with the sweeps, a third panel with
+    the swept response curves (amplitude over the tank half-length)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -47,12 +61,16 @@ def plot(csv_path: Path, png: Path, title: str, sweeps_path: Path | None = None,
     lam = d["lambda"]
     data_label = "shallow-water sweeps" if sweeps else "data"
 
+    curve = read_curve(curve_path) if curve_path and Path(curve_path).exists() else None
+    x = curve["lambda"] if curve is not None else lam
+
     def fit_panel(ax, draw, quantity, model_label, nsd_label, ylabel, **grid):
         """`quantity` over Lambda, drawn by the axes' method `draw`: data, fitted model, NSD law."""
         draw = getattr(ax, draw)
+        src = curve if curve is not None else d
         draw(lam, d[f"{quantity}_data"], "o", label=data_label)
-        draw(lam, d[f"{quantity}_model"], "-", label=model_label)
-        draw(lam, d[f"{quantity}_nsd"], "k--", lw=1, label=nsd_label)
+        draw(x, src[f"{quantity}_model"], "-", label=model_label)
+        draw(x, src[f"{quantity}_nsd"], "k--", lw=1, label=nsd_label)
         ax.set_xlabel("Lambda = A_e / a")
         ax.set_ylabel(ylabel)
         ax.legend(fontsize=8)
@@ -60,23 +78,26 @@ def plot(csv_path: Path, png: Path, title: str, sweeps_path: Path | None = None,
 
     fit_panel(axes[0], "semilogx", "kappa",
               f"Nonlinear model fitted: phi = {fit['phi']:.3g}, eta = {fit['eta']:.3g}",
-              "NSD law (fit of experiments)", "kappa = quadrature frequency / w_f")
+              "NSD law (fit of experiments)", "kappa = jump frequency / w_f")
     fit_panel(axes[1], "loglog", "zeta", f"zeta = {fit['nsd_c']:.3g} Lambda^{fit['nsd_p']:.3g} fitted",
-              "NSD law: 0.5 Lambda^0.35", "zeta (energy-equivalent at quadrature)", which="both")
+              "NSD law: 0.5 Lambda^0.35", "zeta = damping ratio",
+              which="both")
     if sweeps:
         a3 = axes[2]
         half = (length or 1.0) / 2
         for k, lv in enumerate(sorted({p["lambda"] for p in sweeps})):
             colour = f"C{k % 10}"
-            for direction, style in (("up", "-"), ("down", ":")):
+            # up-sweeps a line, down-sweeps open circles: where the two coincide (no jump) the
+            # circles sit on the line and stay visible
+            for direction, style in (("up", dict(ls="-", lw=1)), ("down", dict(ls="none", marker="o", ms=3, mfc="none",
+                                                                                mew=0.6))):
                 pts = [p for p in sweeps if p["lambda"] == lv and p["direction"] == direction]
                 pts.sort(key=lambda p: p["ratio"])
-                a3.semilogy([p["ratio"] for p in pts], [p["x"] / half for p in pts], style,
-                            color=colour, lw=1,
-                            label=f"Lambda = {lv:.3g}" if direction == "up" else None)
+                a3.semilogy([p["ratio"] for p in pts], [p["x"] / half for p in pts], color=colour,
+                            label=f"Lambda = {lv:.3g}" if direction == "up" else None, **style)
         a3.set_xlabel("w / w_f")
         a3.set_ylabel("first harmonic of slosh.x / (a/2)")
-        a3.set_title("up-sweeps solid, down-sweeps dotted", fontsize=8)
+        a3.set_title("up-sweeps: lines; down-sweeps: open circles (on the line where no jump)", fontsize=8)
         a3.legend(fontsize=7)
         a3.grid(alpha=0.3, which="both")
     fig.suptitle(title, fontsize=9)

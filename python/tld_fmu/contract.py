@@ -31,7 +31,30 @@ class Contract:
         try:
             return self.variables[name]
         except KeyError:
-            raise KeyError(f"no variable {name!r} in the modelDescription") from None
+            raise KeyError(f"no variable {name!r} in the modelDescription{closest(name, self.variables)}") from None
+
+    def check(self, name: str, value) -> str | None:
+        """Why `name = value` cannot be set as a parameter (None: it can): an unknown name (with
+        the closest valid ones), no parameter, a wrong type, an Enumeration's unknown item, or a
+        value outside the modelDescription's min..max."""
+        try:
+            v = self.variable(name)
+            if v.causality != "parameter":
+                return f"{name} is no parameter (causality {v.causality})"
+            ((_, setter, x),) = self.typed({name: value})
+        except (KeyError, TypeError, ValueError) as e:
+            return str(e.args[0] if e.args else e)
+        if v.type == "Enumeration":
+            values = [n for _, n, _ in self.items(name)]
+            if x not in values:
+                return f"{name} = {value!r}: not an item of {name} ({', '.join(i for i, _, _ in self.items(name))})"
+            return None
+        if setter != "boolean" and isinstance(value, bool):
+            return f"{name} = {value!r}: a {v.type}, not true/false"
+        lo, hi = (float(b) if b is not None else None for b in (v.min, v.max))
+        if (lo is not None and not x >= lo) or (hi is not None and not x <= hi):
+            return f"{name} = {value!r}: outside its range {v.min}..{v.max} (modelDescription)"
+        return None
 
     def vr(self, name: str) -> int:
         """The value reference of variable `name`."""
@@ -50,7 +73,8 @@ class Contract:
         for n, value, _ in self.items(name):
             if n == item:
                 return value
-        raise KeyError(f"{name} has no item {item!r}: {[n for n, _, _ in self.items(name)]}")
+        names = [n for n, _, _ in self.items(name)]
+        raise KeyError(f"{name} has no item {item!r}: {', '.join(names)}{closest(item, names)}")
 
     def value(self, name: str, value):
         """A parameter value as the FMU takes it: an Enumeration's item may be given by name."""
@@ -89,6 +113,13 @@ class Contract:
         self.set(fmu, values)
         fmu.enterInitializationMode()
         fmu.exitInitializationMode()
+
+
+def closest(name: str, valid) -> str:
+    """'; did you mean A or B?' for the valid names closest to a misspelt one (difflib), else ''."""
+    import difflib
+    near = difflib.get_close_matches(name, list(valid), n=3, cutoff=0.6)
+    return f"; did you mean {' or '.join(repr(n) for n in near)}?" if near else ""
 
 
 @functools.cache

@@ -123,10 +123,12 @@ class StickModel:
 
 
 def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, derivatives=False,
-             yield_forces=None, hardening=0.02, progress=None):
+             yield_forces=None, hardening=0.02, progress=None, floor_forces=None):
     """Co-simulate the building of cfg (tld_fmu.building's TOML layout) in OpenSees with its
     dampers; ground(t) -> (a_g, v_g, x_g). yield_forces: None (elastic storeys) or per storey [N].
-    progress: a tqdm-like object updated per step (or None). Returns the time series at the
+    progress: a tqdm-like object updated per step (or None). floor_forces, if given: external
+    forces on the floors [N] sampled every h/2 from t = 0, as tld_fmu.building.simulate takes them
+    (Newmark uses those at the communication points). Returns the time series at the
     communication points: t, X (floors relative to the ground), A (floors' absolute
     accelerations), S (storey shears), F and E (each damper's force and dissipated energy)."""
     b = cfg["building"]
@@ -144,7 +146,8 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, derivati
     tg = np.append(t, t[-1] + h)
     model = StickModel(b["masses"], b["stiffnesses"], b["rayleigh"], extra, tg,
                        [ground(tk)[0] for tk in tg], yield_forces, hardening,
-                       [dp.floor for dp in dampers])
+                       range(n) if floor_forces is not None else [dp.floor for dp in dampers])
+    ext = (lambda i: floor_forces[i]) if floor_forces is not None else (lambda i: 0.0)  # noqa: E731
     out = {"t": t, "X": np.zeros((steps + 1, n)), "A": np.zeros((steps + 1, n)), "S": np.zeros((steps + 1, n)),
            "F": np.zeros((steps + 1, len(dampers))), "E": np.zeros((steps + 1, len(dampers)))}
 
@@ -165,18 +168,19 @@ def simulate(cfg, unzipdir, md, ground, h, duration, with_dampers=True, derivati
                 ag, vg, xg = ground(tk)
                 # the relative acceleration at t_k with this step's forces (OpenSees' state holds
                 # the extrapolated load it ended the last step with)
-                A0 = A + (F - model.loads) / model.mass
+                A0 = A + (F + ext(2 * k) - model.loads) / model.mass
                 for dp in dampers:
                     i = dp.floor
                     dp.set_inputs(tk, ag + A0[i], vg + V[i], xg + X[i])
                 dF = on_floors(dp.force_rate() for dp in dampers)
-                a_rate = (dF - model.bld.C @ A0 - model.restoring_rate(V)) / model.mass
+                dext = (ext(2 * k + 2) - ext(2 * k)) / h
+                a_rate = (dF + dext - model.bld.C @ A0 - model.restoring_rate(V)) / model.mass
                 for dp in dampers:
                     dp.step_with_rate(tk, h, a_rate[dp.floor])
-                model.set_loads(F + h * dF)
+                model.set_loads(F + h * dF + ext(2 * k + 2))
                 model.step(h)
             else:
-                model.set_loads(on_floors(dp.force for dp in dampers))
+                model.set_loads(on_floors(dp.force for dp in dampers) + ext(2 * k + 2))
                 model.step(h)
             X, V, A = model.state()
             ag, vg, xg = ground(tk + h)

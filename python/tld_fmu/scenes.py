@@ -289,7 +289,7 @@ def compute_references(scenes, inputs, quick, tqdm):
                 futs[ex.submit(ref_job, sc.key, sc.p, sc.kind, sc.coupled, dt, n, subs,
                                None if a is None else a.tobytes(), window)] = (job, f)
             for fut in tqdm(cf.as_completed(futs), total=len(futs), desc="references (RK8)",
-                            unit="run"):
+                            unit="run", disable=None):
                 job, f = futs[fut]
                 sc, dt, n, tag, subs, window, a = job
                 x, X = fut.result()

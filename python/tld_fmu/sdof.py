@@ -38,6 +38,7 @@ import os
 
 import numpy as np
 
+from . import fmulog
 from .contract import Contract
 
 # seed Table 2.1 structure
@@ -81,7 +82,8 @@ def cosimulate(unzipdir, w, A_g, h, t_end, params=None, t_window=20.0, record=Fa
     vr = {n: v.valueReference for n, v in contract.variables.items()}
     fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                     modelIdentifier=md.coSimulation.modelIdentifier, instanceName=f"tld_{w:.4f}")
-    fmu.instantiate()
+    cb = fmulog.callbacks()   # warnings to fmulog.REPORT, each on its own line
+    fmu.instantiate(callbacks=cb)
     try:
         contract.initialise(fmu, params)
         m0 = fmu.getReal([vr["mass.inactive"]])[0]
@@ -188,4 +190,4 @@ def run_one(job):
     unzipdir, w, A_g, h, t_end, t_window = job
     r = cosimulate(unzipdir, w, A_g, h, t_end, t_window=t_window)
     return {"w": w, "with": r["peak"], "settle": abs(r["peak"] - r["peak_prev"]) / r["peak"],
-            "A_e": r["A_e"], "without": bare_structure_peak(w, A_g)}
+            "A_e": r["A_e"], "without": bare_structure_peak(w, A_g), "warnings": fmulog.REPORT.drain()}

@@ -9,20 +9,8 @@ import ctypes
 
 import numpy as np
 
+from . import fmulog
 from .contract import Contract
-
-_LOGGER = None                                   # the one logger fmpy's proxy calls (see Slave)
-_LOG_ROUTES: dict[int, list] = {}                # componentEnvironment -> that Slave's messages
-
-
-def _route_log_message(env, instance, status, category, message):
-    try:
-        messages = _LOG_ROUTES.get(env or 0)
-        if messages is not None:
-            messages.append((int(status), (category or b"").decode("utf-8", "replace"),
-                             (message or b"").decode("utf-8", "replace")))
-    except Exception:  # never let an exception unwind into the FMU
-        pass
 
 
 class Slave:
@@ -31,33 +19,14 @@ class Slave:
     def __init__(self, md, unzipdir, variables, name="tld", logging_on=True, quiet=False):
         """logging_on: fmi2Instantiate's loggingOn. quiet: restrict the debug log to the
         status categories (no per-call logging), for long runs."""
-        from fmpy.fmi2 import (FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
-                               fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE)
-        from fmpy import calloc, free
-        from fmpy.logging import addLoggerProxy
+        from fmpy.fmi2 import FMU2Slave
 
         self.vars = variables
         self.contract = Contract(md)
         self.messages: list[tuple[int, str, str]] = []   # (status, category, message)
 
-        # fmpy's printf-formatting proxy (logging.so) keeps ONE global Python target for every
-        # instance in the process, whatever struct it was installed into: a per-instance Python
-        # logger would dangle there once its Slave is gone, and the next FMU that logs through
-        # fmpy's proxy (any FMU2Slave with the default callbacks) would crash the process. So the
-        # target is one module-level router that lives forever and dispatches on
-        # componentEnvironment.
-        global _LOGGER
-        if _LOGGER is None:
-            _LOGGER = fmi2CallbackLoggerTYPE(_route_log_message)
-        key = len(_LOG_ROUTES) + 1
-        _LOG_ROUTES[key] = self.messages
-        cb = fmi2CallbackFunctions()
-        cb.logger = _LOGGER
-        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        cb.componentEnvironment = key
-        addLoggerProxy(ctypes.byref(cb))   # the proxy in front of the router
-        self._callbacks = cb              # keep alive as long as the instance
+        # this instance's messages, through the process's one logger router (tld_fmu.fmulog)
+        self._callbacks = cb = fmulog.callbacks(lambda _i, st, cat, msg, to=self.messages: to.append((st, cat, msg)))
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
         self.fmu.instantiate(callbacks=cb, loggingOn=logging_on)

@@ -56,6 +56,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from . import fmulog
 from .contract import Contract
 from .paths import BUILDING_FMU, FMU, REPO
 from .ssp_hosts import HOSTS, load_tbb, run_ecos, run_fmpy, run_libcosim  # noqa: F401  (the hosts, here too)
@@ -152,7 +153,8 @@ def inactive_mass(tld_fmu: Path, params: dict) -> float:
     with tempfile.TemporaryDirectory(prefix="tld_ssp_") as d:
         fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(tld_fmu), d),
                         modelIdentifier=md.coSimulation.modelIdentifier, instanceName="mass")
-        fmu.instantiate()
+        cb = fmulog.callbacks()   # warnings to fmulog.REPORT, each on its own line
+        fmu.instantiate(callbacks=cb)
         try:
             contract.initialise(fmu, params)
             return fmu.getReal([contract.vr("mass.inactive")])[0]
@@ -316,9 +318,11 @@ def validate(xml: str, schema: str):
                          + "\n".join(f"  line {e.line}: {e.message}" for e in xsd.error_log))
 
 
-def contents(name: str, tld_fmu: Path = FMU, building_fmu: Path = BUILDING_FMU) -> dict:
-    """The text files of system `name`'s archive {path in the archive: text}, validated."""
-    description, make, (stop, step) = SYSTEMS[name]
+def contents(name: str, tld_fmu: Path = FMU, building_fmu: Path = BUILDING_FMU, system=None) -> dict:
+    """The text files of system `name`'s archive {path in the archive: text}, validated. system:
+    (description, configuration, (stop, step)) as in SYSTEMS, for a system not listed there
+    (scripts/tower.py's)."""
+    description, make, (stop, step) = system or SYSTEMS[name]
     cfg = make()
     tld, bld = Contract(str(tld_fmu)), Contract(str(building_fmu))
     tp = tld_parameters(cfg, tld)
@@ -333,9 +337,9 @@ def contents(name: str, tld_fmu: Path = FMU, building_fmu: Path = BUILDING_FMU) 
 
 
 def write(name: str, out_dir: Path = SYSTEMS_DIR, tld_fmu: Path = FMU,
-          building_fmu: Path = BUILDING_FMU) -> Path:
+          building_fmu: Path = BUILDING_FMU, system=None) -> Path:
     """Write systems/<name>.ssp: the text files of `contents` and both FMUs."""
-    files = contents(name, tld_fmu, building_fmu)
+    files = contents(name, tld_fmu, building_fmu, system)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     path = out_dir / f"{name}.ssp"
@@ -411,6 +415,63 @@ def run(ssp_path: Path, hosts, omega: float, amplitude: float, duration: float, 
     return {host: HOSTS[host](ssp_path, h, steps, list(outputs), a) for host in hosts}
 
 
+def _component(ssp_path: Path, name: str, directory: str):
+    """(model description, unzipped directory) of component `name`'s FMU inside an archive."""
+    from fmpy import extract, read_model_description
+    fmu = Path(directory) / f"{name}.fmu"
+    with zipfile.ZipFile(ssp_path) as z:
+        fmu.write_bytes(z.read(f"resources/{name}.fmu"))
+    return read_model_description(str(fmu)), extract(str(fmu), str(Path(directory) / name))
+
+
+def units(ssp_path: Path, outputs) -> dict:
+    """{"Component.variable": unit} of outputs, from the components' modelDescriptions."""
+    out = {}
+    with tempfile.TemporaryDirectory(prefix="tld_ssp_") as d:
+        for comp in {o.split(".", 1)[0] for o in outputs}:
+            md, _ = _component(ssp_path, comp, d)
+            for v in md.modelVariables:
+                unit = v.unit or (v.declaredType.unit if v.declaredType is not None else None)
+                out[f"{comp}.{v.name}"] = unit or "1"
+    return {o: out.get(o, "?") for o in outputs}
+
+
+def without_damper(ssp_path: Path, h: float, steps: int, outputs, ground_a=None) -> dict:
+    """The archive's Building.fmu alone, without the damper: its Building.ssv parameters but
+    tld.mass = 0 and tld.force = 0, the same ground motion, steps of h (fmpy); {output: array at
+    t_0..t_n} for the Building outputs among `outputs`."""
+    from fmpy.fmi2 import FMU2Slave
+    from lxml import etree
+    doc = etree.fromstring(read(ssp_path, "resources/Building.ssv").encode())
+    params = {}
+    for p in doc.iter(f"{{{SSV_NS}}}Parameter"):
+        v = p[0]
+        params[p.get("name")] = int(v.get("value")) if etree.QName(v).localname == "Integer" else float(v.get("value"))
+    params["tld.mass"] = 0.0
+    names = [o.split(".", 1)[1] for o in outputs if o.startswith("Building.")]
+    with tempfile.TemporaryDirectory(prefix="tld_ssp_") as d:
+        md, unzipdir = _component(ssp_path, "Building", d)
+        c = Contract(md)
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier,
+                        instanceName="bare")
+        cb = fmulog.callbacks()
+        fmu.instantiate(callbacks=cb)
+        try:
+            c.initialise(fmu, params)
+            vrs = [c.vr(n) for n in names]
+            res = np.empty((steps + 1, len(names)))
+            res[0] = fmu.getReal(vrs)
+            for k in range(steps):
+                if ground_a is not None:
+                    fmu.setReal([c.vr("ground.a")], [float(ground_a[k])])
+                fmu.doStep(k * h, h)
+                res[k + 1] = fmu.getReal(vrs)
+        finally:
+            fmu.terminate()
+            fmu.freeInstance()
+    return {f"Building.{n}": res[:, j] for j, n in enumerate(names)}
+
+
 def main(argv=None):
     import argparse
     ap = argparse.ArgumentParser(
@@ -453,17 +514,32 @@ def main(argv=None):
     a_b, w_b = built_in_ground(Path(args.ssp))
     added = f" + ground.a: x_g = {args.amplitude:g} (1 - cos {args.omega:g} t) m" if args.amplitude else ""
     print(f"{args.ssp}: {n} steps of {args.step} s, built-in x_g = {a_b:g} sin({w_b:.6g} t) m{added}")
+    unit = units(Path(args.ssp), list(first))
     for host, res in runs.items():
-        print(f"  {host:9s} " + ", ".join(f"max|{o}| = {np.max(np.abs(v)):.9g}" for o, v in res.items()))
+        print(f"  {host:9s} " + ", ".join(f"max|{o}| = {np.max(np.abs(v)):.9g} {unit[o]}" for o, v in res.items()))
     for host in hosts[1:]:
         worst = max(float(np.max(np.abs(runs[host][o] - first[o])) / np.max(np.abs(first[o])))
                     for o in first)
         print(f"  {host} vs {hosts[0]}: max relative difference {worst:.2e}")
+    ga = None
+    if args.amplitude:
+        g = harmonic_ground(args.omega, args.amplitude)
+        ga = [g(k * args.step)[0] for k in range(n)]
+    bare = without_damper(Path(args.ssp), args.step, n, list(first), ga)
+    print(f"  the same building without the damper over the same {n * args.step:g} s (Building.fmu alone, "
+          f"tld.mass = 0, fmpy), against {hosts[0]} with it:")
+    for o, v in bare.items():
+        b, d = float(np.max(np.abs(v))), float(np.max(np.abs(first[o])))
+        print(f"    max|{o}|: {b:.6g} {unit[o]} without, {d:.6g} {unit[o]} with the damper "
+              f"({100 * (1 - d / b):.1f} % less)")
     if args.csv:
         cols = ["time"] + list(first)
         data = np.column_stack([np.arange(n + 1) * args.step] + [first[o] for o in first])
         np.savetxt(args.csv, data, delimiter=",", header=",".join(cols), comments="")
         print(f"wrote {args.csv} ({hosts[0]})")
+    # the FMU messages that reached Python (fmpy's host and the run without the damper);
+    # libcosim and Ecos print their FMUs' messages themselves as they run
+    fmulog.REPORT.print_summary()
 
 
 if __name__ == "__main__":

@@ -1,7 +1,9 @@
 """The SSP hosts that install here, each running an archive of tld_fmu.ssp: `run_libcosim`
 (libcosimpy), `run_ecos` (ecospy), `run_fmpy` (fmpy.ssp). Each runs `steps` steps of h, sets
 Building.ground.a before step k to ground_a[k] if given (added to Building's built-in ground
-motion), else not at all, and returns {"Component.variable": array over t_0..t_n}."""
+motion), else not at all, and likewise every input of `inputs` ({"Component.variable": values per
+step}, e.g. Building's floor[i].force: wind), and returns {"Component.variable": array over
+t_0..t_n}."""
 from __future__ import annotations
 
 import ctypes
@@ -15,7 +17,15 @@ def _columns(outputs):
     return [tuple(o.split(".", 1)) for o in outputs]
 
 
-def run_libcosim(ssp: Path, h: float, steps: int, outputs, ground_a=None) -> dict:
+def _inputs(ground_a, inputs) -> list:
+    """[((component, variable), values per step)]: ground_a as Building.ground.a, and `inputs`."""
+    given = dict(inputs or {})
+    if ground_a is not None:
+        given["Building.ground.a"] = ground_a
+    return list(zip(_columns(given), given.values()))
+
+
+def run_libcosim(ssp: Path, h: float, steps: int, outputs, ground_a=None, inputs=None) -> dict:
     """libcosim (libcosimpy): the archive as libcosim loads it (CosimExecution.from_ssp_file, a
     fixed-step execution of step h, integer nanoseconds), ground.a (if given) through an
     override manipulator before each step, the outputs from a last-value observer. ground_a[k]
@@ -25,8 +35,16 @@ def run_libcosim(ssp: Path, h: float, steps: int, outputs, ground_a=None) -> dic
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimManipulator import CosimManipulator
     from libcosimpy.CosimObserver import CosimObserver
-    log_output_level(CosimLogLevel.WARNING)
-    ex = CosimExecution.from_ssp_file(str(Path(ssp).resolve()), round(h * 1e9))
+    # Loading, libcosim warns once per Enumeration variable of TLD.fmu (model, damping, amplitude,
+    # solver: "FMI 2.0 Enumeration variable type not supported ... will be ignored"). Nothing is
+    # lost: the archive sets those parameters through their Integer aliases (model_id, ...), which
+    # libcosim handles. Those four lines are all it says while loading these archives, so the load
+    # runs at level error; the run itself at warning.
+    log_output_level(CosimLogLevel.ERROR)
+    try:
+        ex = CosimExecution.from_ssp_file(str(Path(ssp).resolve()), round(h * 1e9))
+    finally:
+        log_output_level(CosimLogLevel.WARNING)
     index = {s.name.decode(): s.index for s in ex.slave_infos()}
     vr = {name: {v.name.decode(): v.reference for v in ex.slave_variables(i)} for name, i in index.items()}
     man, obs = CosimManipulator.create_override(), CosimObserver.create_last_value()
@@ -35,14 +53,14 @@ def run_libcosim(ssp: Path, h: float, steps: int, outputs, ground_a=None) -> dic
     cols = _columns(outputs)
     n = steps
     res = np.empty((n + 1, len(cols)))
-    g = index["Building"], [vr["Building"]["ground.a"]]
+    given = [(index[c], [vr[c][v]], values) for (c, v), values in _inputs(ground_a, inputs)]
 
     def read(k):
         for j, (c, v) in enumerate(cols):
             res[k, j] = obs.last_real_values(index[c], [vr[c][v]])[0]
     for k in range(n):
-        if ground_a is not None:
-            man.slave_real_values(g[0], g[1], [float(ground_a[k])])
+        for i, refs, values in given:
+            man.slave_real_values(i, refs, [float(values[k])])
         ex.step(1)
         if k == 0:
             # the observer sees values after the first step only: t_0 is the state at rest
@@ -62,7 +80,7 @@ def load_tbb():
                            f"(pinned in scripts/requirements.txt) ({e})") from e
 
 
-def run_ecos(ssp: Path, h: float, steps: int, outputs, ground_a=None) -> dict:
+def run_ecos(ssp: Path, h: float, steps: int, outputs, ground_a=None, inputs=None) -> dict:
     """Ecos (ecospy): EcosSimulation from the archive, ground.a (if given) set between steps (Ecos
     passes it on right before the next fmi2DoStep), outputs read after each step. Needs `unzip`
     on PATH."""
@@ -76,9 +94,10 @@ def run_ecos(ssp: Path, h: float, steps: int, outputs, ground_a=None) -> dict:
         n = steps
         res = np.empty((n + 1, len(ident)))
         res[0] = [sim.get_real(i) for i in ident]
+        given = [(f"{c}::{v}", values) for (c, v), values in _inputs(ground_a, inputs)]
         for k in range(n):
-            if ground_a is not None:
-                sim.set_real("Building::ground.a", float(ground_a[k]))
+            for name, values in given:
+                sim.set_real(name, float(values[k]))
             sim.step()
             res[k + 1] = [sim.get_real(i) for i in ident]
     finally:
@@ -87,7 +106,7 @@ def run_ecos(ssp: Path, h: float, steps: int, outputs, ground_a=None) -> dict:
     return {o: res[:, j] for j, o in enumerate(outputs)}
 
 
-def run_fmpy(ssp: Path, h: float, steps: int, outputs, ground_a=None) -> dict:
+def run_fmpy(ssp: Path, h: float, steps: int, outputs, ground_a=None, inputs=None) -> dict:
     """fmpy's SSP support (fmpy.ssp): its reader of the archive (schema-validated), its
     instantiation of the components and its Jacobi step `do_step` (set the inputs from the
     connectors, fmi2DoStep, get the outputs), the connections applied after every step as
@@ -129,6 +148,8 @@ def run_fmpy(ssp: Path, h: float, steps: int, outputs, ground_a=None) -> dict:
         for start, end in connections:
             end.value = start.value
         ground = conn[("Building", "ground.a")]
+        from fmpy.ssp.simulation import set_value
+        others = _inputs(None, inputs)
         cols = _columns(outputs)
         n = steps
         res = np.empty((n + 1, len(cols)))
@@ -140,6 +161,8 @@ def run_fmpy(ssp: Path, h: float, steps: int, outputs, ground_a=None) -> dict:
         for k in range(n):
             if ground_a is not None:
                 ground.value = float(ground_a[k])
+            for (c, v), values in others:   # inputs that are no connectors of the SSD
+                set_value(components[c], v, float(values[k]))
             for comp in components.values():
                 do_step(comp, t, h)
             for start, end in connections:

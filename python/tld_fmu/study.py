@@ -50,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import building
+from . import building, fmulog
 from . import peaks as pk
 from .paths import FMU, REPO
 from .studyfile import COLUMNS, StudyError, check_study, dump_study, load_study  # noqa: F401 (this module's API)
@@ -106,12 +106,24 @@ def expand(study: dict, unzipdir, md) -> list[dict]:
             w_f, m_liquid, m_inactive = probe(unzipdir, md, {**params, **variant}, tanks)
             for tuning, amp, r in itertools.product(sw["tuning"], sw["ground_amplitude"], np.linspace(f0, f1, int(nf))):
                 w_s = w_f / tuning
+                refuse, flag = fmulog.plausibility(m_liquid / st["mass"], tuning)
                 runs.append({"index": len(runs), **variant, "params": variant, "tuning": tuning, "tanks": tanks,
-                             "mass_ratio": m_liquid / st["mass"],
+                             "mass_ratio": m_liquid / st["mass"], "plausibility": _flag(refuse + flag),
                              "ground_amplitude": amp, "frequency_ratio": float(r), "omega_s": w_s,
                              # the inactive liquid moves with the structure: K tunes M + inactive
                              "stiffness": (st["mass"] + m_inactive) * w_s ** 2, "inactive": m_inactive})
     return runs
+
+
+def _flag(problems: list[str]) -> str:
+    """A run's plausibility column: '' or what is implausible, short and CSV-safe."""
+    out = []
+    for p in problems:
+        if "water mass" in p:
+            out.append(f"mass ratio above {fmulog.MASS_RATIO_MAX:g}")
+        else:
+            out.append(f"tuning outside {fmulog.TUNING_BAND[0]:g}-{fmulog.TUNING_BAND[1]:g}")
+    return " & ".join(out)
 
 
 def _config(study: dict, run: dict) -> tuple[dict, float, float]:
@@ -131,12 +143,14 @@ def run_one(fmu_bytes: bytes, digest: str, study: dict, run: dict, fresh: bool =
     unzipdir, md, pool = _fmu_on_worker(fmu_bytes, digest)
     rn = study["run"]
     cfg, w, a = _config(study, run)
-    s = building.simulate(cfg, unzipdir, md, building.harmonic_ground(w, a), rn["step"], rn["duration"], pool=None if fresh else pool,
-                          derivatives=bool(rn.get("derivatives", False)))
+    with fmulog.collected() as warned:   # they travel with the row (a worker's lines would be lost)
+        s = building.simulate(cfg, unzipdir, md, building.harmonic_ground(w, a), rn["step"], rn["duration"],
+                              pool=None if fresh else pool, derivatives=bool(rn.get("derivatives", False)))
     tail = s["t"] > rn["duration"] - rn["tail"]
     peak = float(np.max(np.abs(s["X"][tail, 0])))
     return _row(run, peak_displacement=peak, amplification=peak / a,
-                worker=f"{os.getpid()}/{threading.get_ident()}", instances=len(pool.dampers), error="")
+                worker=f"{os.getpid()}/{threading.get_ident()}", instances=len(pool.dampers), error="",
+                fmu_warnings=fmulog.as_text(warned))
 
 
 def run_name(run: dict) -> str:
@@ -189,7 +203,8 @@ def run_batch(fmu_bytes: bytes, digest: str, master_bytes: bytes, master_digest:
         else:
             peak = got["peak"][0]
             rows.append(_row(r, peak_displacement=peak, amplification=peak / r["ground_amplitude"],
-                             worker=where, instances=got["instances"], error=""))
+                             worker=where, instances=got["instances"], error="",
+                             fmu_warnings=fmulog.as_text(fmulog.from_text(got.get("warnings", "")))))
     return rows
 
 
@@ -294,7 +309,7 @@ def run_study(study: dict, fmu_path: Path, client=None, progress=True, engine: s
     ex = executor or Executor(study, fmu_path, client, engine)
     runs = expand(study, ex.unzipdir, ex.md)
     from tqdm import tqdm
-    bar = tqdm(total=len(runs), desc=f"runs ({ex.engine} master)", disable=not progress)
+    bar = tqdm(total=len(runs), desc=f"runs ({ex.engine} master)", disable=None if progress else True)
     t0 = time.perf_counter()
     rows = ex.run(runs, bar)
     bar.close()
@@ -309,12 +324,18 @@ def failed_row(run: dict, error: Exception) -> dict:
         text = text[len(name) + 2:]
     msg = f"{name + ': ' if name else ''}{type(error).__name__}: {text}"
     return _row(run, peak_displacement=math.nan, amplification=math.nan, worker="", instances=0,
-                error=msg.replace(",", ";").replace("\n", " "))
+                error=msg.replace(",", ";").replace("\n", " "), fmu_warnings="")
 
 
 def connect(scheduler: str | None, workers: int):
     """A client: on an existing scheduler, or on a new LocalCluster of single-threaded worker
     processes. The scripts are uploaded so that remote workers can import them."""
+    import logging
+    import sys
+    if not sys.stderr.isatty():
+        # a log file gets the results, not the cluster's INFO lines (its workers inherit this)
+        os.environ["DASK_LOGGING__DISTRIBUTED"] = "warning"
+        logging.getLogger("distributed").setLevel(logging.WARNING)
     from distributed import Client, LocalCluster
     if scheduler:
         client, cluster = Client(scheduler), None
@@ -351,14 +372,15 @@ def _package_zip(directory: Path) -> str:
 
 def write_table(rows: list[dict], path: Path, axes: list[str] = ()):
     """A row per run; axes: the varied FMU parameters' columns (first)."""
-    cols = list(axes) + COLUMNS + ["worker", "instances", "error"]
+    cols = list(axes) + COLUMNS + ["worker", "instances", "error", "fmu_warnings"]
     if any("refinement" in r for r in rows):
         cols.append("refinement")
         rows = [{"refinement": 0, **r} for r in rows]
     with open(path, "w") as fh:
         fh.write(",".join(cols) + "\n")
         for r in rows:
-            fh.write(",".join(repr(r[c]) if isinstance(r[c], float) else str(r[c]) for c in cols) + "\n")
+            fh.write(",".join(repr(r[c]) if isinstance(r[c], float) else str(r[c]).replace(",", ";")
+                              for c in cols) + "\n")
 
 
 def _case(r: dict) -> tuple:
@@ -382,7 +404,7 @@ def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xto
     curves = {c: ([runs[i]["frequency_ratio"] for i in idx], [rows[i]["amplification"] for i in idx])
               for c, idx in cases.items() if not any(math.isnan(rows[i]["amplification"]) for i in idx)}
     from tqdm import tqdm
-    bar = tqdm(desc=f"peak refinement runs ({ex.engine} master)", disable=not progress)
+    bar = tqdm(desc=f"peak refinement runs ({ex.engine} master)", disable=None if progress else True)
     extra: list[dict] = []
 
     def evaluate(batch):
@@ -401,7 +423,8 @@ def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xto
     out = []
     for c, idx in cases.items():
         first = rows[idx[0]]
-        base = {**runs[idx[0]]["params"], **{k: first[k] for k in ("tuning", "tanks", "mass_ratio", "ground_amplitude")}}
+        base = {**runs[idx[0]]["params"],
+                **{k: first[k] for k in ("tuning", "tanks", "mass_ratio", "ground_amplitude", "plausibility")}}
         if c not in found:
             out.append({**base, "peak_frequency_ratio": math.nan, "peak_amplification": math.nan, "xtol": xtol,
                         "grid_frequency_ratio": math.nan, "grid_amplification": math.nan, "bounded": False,
@@ -416,7 +439,7 @@ def refine_study(study: dict, fmu_path: Path, rows: list[dict], client=None, xto
 
 
 PEAK_COLUMNS = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "peak_frequency_ratio", "peak_amplification",
-                "xtol", "grid_frequency_ratio", "grid_amplification", "bounded", "refinement_runs", "note"]
+                "xtol", "grid_frequency_ratio", "grid_amplification", "bounded", "refinement_runs", "note", "plausibility"]
 
 
 def write_peaks(peaks: list[dict], path: Path, axes: list[str] = ()):
@@ -472,6 +495,12 @@ def main(argv=None):
     chart = out / f"{name}-best.png"
     best_tuning(peaks, chart, study["structure"].get("damping"), name, axes(study))
     where = "serial" if args.serial else (args.scheduler or f"LocalCluster, {args.workers} workers")
+    for r in rows + extra:
+        fmulog.REPORT.merge(fmulog.from_text(r.get("fmu_warnings", "")))
+    flagged = [p for p in peaks if p["plausibility"]]
+    for p in flagged:
+        fmulog.REPORT.add("implausible configuration (flagged in the plausibility column)",
+                          f"{p['tanks']} tank(s) at tuning {p['tuning']:g}: {p['plausibility']}")
     failed = [r for r in rows if r["error"]]
     if failed:
         print(f"{len(failed)} of {len(rows)} runs failed (NaN in the table, reason in its 'error' column); "
@@ -481,4 +510,31 @@ def main(argv=None):
           f"FMU instance(s) each; then {len(extra)} refinement runs in {wall_refine:.1f} s "
           f"(peaks to +-{args.xtol:g} w_s)")
     print(f"wrote {table}, {peaks_file}, {png}, {chart}")
+    for line in best_designs(peaks, study["structure"]["damping"], axes(study)):
+        print(line)
+    fmulog.REPORT.print_summary()
     return rows
+
+
+def best_designs(peaks: list[dict], zeta: float, axes: list[str] = ()) -> list[str]:
+    """The engineering answer of a study: per ground amplitude (and combination of the varied
+    FMU parameters), the plausible case with the lowest refined peak amplification, against the
+    bare structure's (closed form)."""
+    bare = bare_peak_amplification(zeta)
+    groups: dict[tuple, list[dict]] = {}
+    for p in peaks:
+        groups.setdefault((p["ground_amplitude"], *(p[a] for a in axes)), []).append(p)
+    lines = []
+    for key, ps in groups.items():
+        ok = [p for p in ps if not p["plausibility"] and not math.isnan(p["peak_amplification"])]
+        varied = "".join(f", {a} = {v}" for a, v in zip(axes, key[1:]))
+        if not ok:
+            lines.append(f"best design at ground amplitude {key[0]:g} m{varied}: none (every case failed or was flagged)")
+            continue
+        b = min(ok, key=lambda p: p["peak_amplification"])
+        lines.append(f"best design at ground amplitude {key[0]:g} m{varied}: tuning {b['tuning']:g}, {b['tanks']} tank(s) "
+                     f"(mass ratio {b['mass_ratio']:.3g}): peak |X|/x_g {b['peak_amplification']:.4g} at w/w_s "
+                     f"{b['peak_frequency_ratio']:.4f}, against {bare:.4g} for the bare structure "
+                     f"({100 * (1 - b['peak_amplification'] / bare):.1f} % less)"
+                     + ("" if b["bounded"] else " [peak at the edge of the frequency range]"))
+    return lines

@@ -1,5 +1,5 @@
-"""Study files for tld_fmu.study (scripts/sweep.py): what a study TOML may hold, checked before
-anything runs (check_study, load_study: unknown sections and keys, missing and impossible
+"""Study files for tld_fmu.study (scripts/sweep.py) and building files (scripts/building.py,
+scripts/opensees.py): what a TOML may hold, checked before anything runs (check_study, load_study: unknown sections and keys, missing and impossible
 values, FMU parameters the modelDescription lacks, all named at once), and a study dict written
 back as TOML (dump_study)."""
 from __future__ import annotations
@@ -8,9 +8,11 @@ import math
 import tomllib
 from pathlib import Path
 
+from .contract import closest
+
 # the columns of a study's table that come from its runs (tld_fmu.study)
 COLUMNS = ["tuning", "tanks", "mass_ratio", "ground_amplitude", "frequency_ratio", "omega_s",
-           "peak_displacement", "amplification"]
+           "peak_displacement", "amplification", "plausibility"]
 
 
 class StudyError(ValueError):
@@ -44,17 +46,16 @@ def check_study(study: dict, contract) -> None:
 
     for sec, table in study.items():
         if sec not in _SCHEMA:
-            errs.append(f"unknown section [{sec}] (known: {', '.join(_SCHEMA)})")
+            errs.append(f"unknown section [{sec}]{closest(sec, _SCHEMA)} (known: {', '.join(_SCHEMA)})")
         elif not isinstance(table, dict):
             errs.append(f"[{sec}] must be a table")
         else:
-            errs += [f"unknown key {k!r} in [{sec}] (known: {', '.join(_SCHEMA[sec])})"
+            errs += [f"unknown key {k!r} in [{sec}]{closest(k, _SCHEMA[sec])} (known: {', '.join(_SCHEMA[sec])})"
                      for k in table if k not in _SCHEMA[sec]]
-    for sec, keys in _REQUIRED.items():
-        errs += [f"[{sec}] {k} is missing: {_SCHEMA[sec][k]}" for k in keys
-                 if k not in study.get(sec, {}) if isinstance(study.get(sec, {}), dict)]
-    if errs:
-        raise StudyError("; ".join(errs))
+    missing = [f"[{sec}] {k} is missing: {_SCHEMA[sec][k]}" for sec, keys in _REQUIRED.items() for k in keys
+               if not isinstance(study.get(sec, {}), dict) or k not in study.get(sec, {})]
+    if missing or any(not isinstance(t, dict) for t in study.values()):
+        raise StudyError(_listed(errs + missing))
     st, sw, rn = study["structure"], study["study"], study["run"]
 
     def want(ok, sec, key):
@@ -77,14 +78,9 @@ def check_study(study: dict, contract) -> None:
     want(isinstance(rn.get("derivatives", False), bool), "run", "derivatives") if "derivatives" in rn else None
 
     def param(name, value, where):
-        try:
-            v = contract.variable(name)
-            if v.causality != "parameter":
-                errs.append(f"{where}: {name} is no parameter (causality {v.causality})")
-                return
-            contract.typed({name: value})
-        except (KeyError, TypeError, ValueError) as e:
-            errs.append(f"{where}: {e.args[0] if e.args else e}")
+        why = contract.check(name, value)
+        if why:
+            errs.append(f"{where}: {why}")
 
     fixed = study.get("damper", {}).get("params", {})
     if not isinstance(fixed, dict):
@@ -105,7 +101,12 @@ def check_study(study: dict, contract) -> None:
             for value in values:
                 param(name, value, f"[study] params.{name}")
     if errs:
-        raise StudyError("; ".join(errs))
+        raise StudyError(_listed(errs))
+
+
+def _listed(errs: list[str]) -> str:
+    """Every problem, one per line."""
+    return f"{len(errs)} problem{'s' if len(errs) > 1 else ''}:\n" + "\n".join(f"  - {e}" for e in errs)
 
 
 def dump_study(d: dict) -> str:
@@ -126,14 +127,71 @@ def dump_study(d: dict) -> str:
 
 def load_study(path: Path, contract) -> dict:
     """A study file, read and checked (StudyError names what is wrong)."""
+    return _load(path, check_study, contract)
+
+
+def _load(path: Path, check, contract) -> dict:
     try:
-        study = tomllib.loads(Path(path).read_text())
+        cfg = tomllib.loads(Path(path).read_text())
     except tomllib.TOMLDecodeError as e:
         raise StudyError(f"{path}: not valid TOML: {e}") from None
     except OSError as e:
         raise StudyError(f"{path}: {e.strerror}") from None
     try:
-        check_study(study, contract)
+        check(cfg, contract)
     except StudyError as e:
         raise StudyError(f"{path}: {e}") from None
-    return study
+    return cfg
+
+
+# the keys a building file may have (scripts/building.py, scripts/opensees.py)
+_BUILDING = {
+    "building": ("masses", "stiffnesses", "rayleigh"),
+    "dampers": ("floor", "tanks", "params"),
+    "load": ("kind", "ground_amplitude", "from", "to", "points", "duration", "record", "force_rms", "band",
+             "corner", "coherence", "seed"),
+    "coupling": ("step", "derivatives"),
+}
+
+
+def check_building(cfg: dict, contract) -> None:
+    """Raise StudyError listing everything wrong with a building file that can be told before
+    a run: unknown sections and keys (with the closest known ones), floors off the building,
+    and damper parameters the modelDescription does not have or does not allow (unknown name,
+    Enumeration item, range)."""
+    errs = []
+    for sec, table in cfg.items():
+        if sec not in _BUILDING:
+            errs.append(f"unknown section [{sec}]{closest(sec, _BUILDING)} (known: {', '.join(_BUILDING)})")
+            continue
+        for i, t in enumerate(table if sec == "dampers" and isinstance(table, list) else [table]):
+            where = f"[[dampers]] {i + 1}" if sec == "dampers" else f"[{sec}]"
+            if not isinstance(t, dict):
+                errs.append(f"{where} must be a table")
+                continue
+            errs += [f"unknown key {k!r} in {where}{closest(k, _BUILDING[sec])} (known: {', '.join(_BUILDING[sec])})"
+                     for k in t if k not in _BUILDING[sec]]
+    b = cfg.get("building", {})
+    errs += [f"[building] {k} is missing" for k in _BUILDING["building"] if isinstance(b, dict) and k not in b]
+    n = len(b.get("masses", [])) if isinstance(b, dict) else 0
+    for i, d in enumerate(cfg.get("dampers", []) if isinstance(cfg.get("dampers", []), list) else []):
+        if not isinstance(d, dict):
+            continue
+        floor = d.get("floor")
+        if not (isinstance(floor, int) and 1 <= floor <= max(n, 1)):
+            errs.append(f"[[dampers]] {i + 1}: floor = {floor!r}: need a whole number 1..{n} (1-based, from the ground up)")
+        params = d.get("params", {})
+        if not isinstance(params, dict):
+            errs.append(f"[[dampers]] {i + 1}: params must be a table {{name = value}}")
+            continue
+        for name, value in {"tanks": d.get("tanks", 1), **params}.items():
+            why = contract.check(name, value)
+            if why:
+                errs.append(f"[[dampers]] {i + 1} params: {why}")
+    if errs:
+        raise StudyError(_listed(errs))
+
+
+def load_building(path: Path, contract) -> dict:
+    """A building file, read and checked (StudyError names what is wrong)."""
+    return _load(path, check_building, contract)

@@ -5,6 +5,7 @@
 
 pub mod calibration;
 pub mod coupled;
+pub mod design;
 pub mod harmonic;
 pub mod linearisation;
 pub mod random;

@@ -4,6 +4,7 @@ use super::{Parameters, choice};
 use crate::description::{AmplitudeModeItem, DampingLawItem, vr};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange, boundary_layer_zeta};
+use crate::physics::screens::Arrangement;
 
 /// Where the excitation amplitude of the amplitude laws comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,6 +25,8 @@ pub struct Common {
     pub damping: DampingLaw,
     pub lambda: LambdaRange,
     pub amplitude: AmplitudeSource,
+    /// The damping screens of each tank.
+    pub screens: Arrangement,
     /// Initial relative displacement [m] and velocity [m/s] of the (fundamental) sloshing mass.
     pub x0: f64,
     pub v0: f64,
@@ -48,19 +51,34 @@ impl Common {
             density: p.value(vr::LIQUID_DENSITY),
             g: p.value(vr::G),
         };
+        let screens = Arrangement {
+            count: p.count(vr::SCREENS_COUNT),
+            solidity: p.value(vr::SCREENS_SOLIDITY),
+            spacing: p.value(vr::SCREENS_SPACING),
+            loss: p.value(vr::SCREENS_LOSS),
+        };
+        screens.check(tank.length)?;
+        let boundary = || {
+            boundary_layer_zeta(
+                tank.fundamental().omega,
+                tank.depth,
+                tank.breadth,
+                p.value(vr::LIQUID_VISCOSITY),
+                p.value(vr::DAMPING_CONTAMINATION),
+            )
+        };
         let damping = match choice(p, vr::DAMPING)? {
             DampingLawItem::Constant => DampingLaw::Constant(p.value(vr::ZETA)),
             DampingLawItem::NSD => DampingLaw::Nsd {
                 c: p.value(vr::NSD_C),
                 p: p.value(vr::NSD_P),
             },
-            DampingLawItem::BoundaryLayer => DampingLaw::BoundaryLayer(boundary_layer_zeta(
-                tank.fundamental().omega,
-                tank.depth,
-                tank.breadth,
-                p.value(vr::LIQUID_VISCOSITY),
-                p.value(vr::DAMPING_CONTAMINATION),
-            )),
+            DampingLawItem::BoundaryLayer => DampingLaw::BoundaryLayer(boundary()),
+            DampingLawItem::Screens => DampingLaw::Screens {
+                boundary: boundary(),
+                per_response: screens
+                    .zeta_per_response(tank.length, tank.fundamental().mass / tank.liquid_mass()),
+            },
         };
         let amplitude = match choice(p, vr::AMPLITUDE)? {
             AmplitudeModeItem::Fixed => AmplitudeSource::Fixed(p.value(vr::A_E)),
@@ -78,6 +96,7 @@ impl Common {
                 max: p.value(vr::LAMBDA_MAX),
             },
             amplitude,
+            screens,
             x0: p.value(vr::SLOSH_X0),
             v0: p.value(vr::SLOSH_V0),
         };

@@ -1,6 +1,7 @@
 //! Damping laws: the amplitude-dependent NSD fits of Yu, Wakahara & Reed (1999) as parameters,
 //! with Lambda = A_e / a clamped to the fitted range (MODEL.md section 2), and the laminar
-//! boundary layers' amplitude-independent damping (MODEL.md section 8).
+//! boundary layers' amplitude-independent damping (MODEL.md section 8), and the damping screens'
+//! amplitude-dependent equivalent damping on top of it (MODEL.md section 9).
 
 /// Clamp range of the non-dimensional excitation amplitude Lambda = A_e / a.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -28,6 +29,10 @@ pub enum DampingLaw {
     Nsd { c: f64, p: f64 },
     /// The boundary layers' zeta ([`boundary_layer_zeta`]), fixed by the tank and the liquid.
     BoundaryLayer(f64),
+    /// Damping screens (MODEL.md 9): the boundary layers' zeta plus the screens' equivalent
+    /// damping zeta_s = per_response X at the resonant response X = A_e/(2 zeta)
+    /// ([`crate::physics::screens::resonant_zeta`]).
+    Screens { boundary: f64, per_response: f64 },
 }
 
 /// Damping ratio of the fundamental mode by the laminar boundary layers on the bottom and the
@@ -46,6 +51,10 @@ impl DampingLaw {
             DampingLaw::Constant(z) => z,
             DampingLaw::Nsd { c, p } => c * range.clamp(a_e / length).powf(p),
             DampingLaw::BoundaryLayer(z) => z,
+            DampingLaw::Screens {
+                boundary,
+                per_response,
+            } => crate::physics::screens::resonant_zeta(boundary, per_response, a_e),
         }
     }
 }

@@ -8,5 +8,6 @@ pub mod laws;
 pub mod linear;
 pub mod nonlinear;
 pub mod power;
+pub mod screens;
 pub mod shallow_water;
 pub mod slamming;

@@ -1,6 +1,7 @@
-"""The README's host snippets are the files in examples/, and they run (issue #18).
+"""The documentation's host snippets are the files in examples/, and they run (issue #18).
 
-- The README shows each example verbatim in a fenced block right after a marker line
+- The README and the documents it links for hosts (docs/USING.md, docs/COUPLING.md: DOCUMENTS)
+  show each example verbatim in a fenced block right after a marker line
   `<!-- example: examples/NAME.py -->`; every ```python block carries either such a marker or a
   `<!-- not run: REASON -->` one, and every examples/*.py is shown. So a snippet cannot drift
   from the file the suite runs, and no untested snippet can be added.
@@ -11,7 +12,7 @@
   that all of them run the same scene (the old ecospy snippet had 2 tanks), and their output.
 - Without the FMU each example stops with a message naming the path (libcosim alone would die
   with SIGSEGV and no word).
-- The integers the README gives for the enumeration items are those of the modelDescription.
+- The integers these documents give for the enumeration items are those of the modelDescription.
 """
 from __future__ import annotations
 
@@ -29,6 +30,8 @@ from tld_fmu.contract import items
 from tld_fmu.paths import REPO
 
 README = REPO / "README.md"
+# where the snippets and the enumeration values are shown (the README links them)
+DOCUMENTS = [README, REPO / "docs" / "USING.md", REPO / "docs" / "COUPLING.md"]
 EXAMPLES = sorted(p.name for p in (REPO / "examples").glob("*.py"))
 SECONDS = 2.0            # the duration the suite runs each example for (their default: 60 s)
 DT = 0.01                # the examples' scene
@@ -72,15 +75,26 @@ def drift(text: str) -> list[str]:
     return problems
 
 
+def documents_text() -> str:
+    """The DOCUMENTS, one after the other (each ends with a newline)."""
+    return "".join(p.read_text() for p in DOCUMENTS)
+
+
+def test_readme_links_the_documents_with_the_snippets():
+    readme = README.read_text()
+    for p in DOCUMENTS[1:]:
+        assert f"(docs/{p.name})" in readme and p.is_file(), p
+
+
 def test_readme_blocks_are_the_example_files():
-    text = README.read_text()
+    text = documents_text()
     assert len(EXAMPLES) >= 3
     assert drift(text) == []
 
 
 def test_drift_is_detected():
     """The check can fail: an edited block, an unmarked block, a missing example."""
-    text = README.read_text()
+    text = documents_text()
     edited = text.replace('"zeta": 0.02', '"zeta": 0.03', 1)
     assert edited != text
     assert any("differs" in p for p in drift(edited))
@@ -150,7 +164,7 @@ def readme_enumeration_values(text: str):
 
 
 def test_readme_enumeration_values_are_the_model_descriptions():
-    stated = readme_enumeration_values(README.read_text())
+    stated = readme_enumeration_values(documents_text())
     assert {v for v, _ in stated} >= {"damping", "amplitude", "solver"}
     for (variable, item), value in stated.items():
         actual = {n: v for n, v, _ in items(variable)}

@@ -37,7 +37,7 @@ def test_exports_only_fmi2_functions(fmu_path, tmp_path):
     other = [n for n in names if not n.startswith("fmi2")]
     assert len(fmi) == EXPECTED_FMI2, fmi
     # callback_log: a #[no_mangle] function of the fmi-sys crate, exported from every cdylib
-    # that links it; never called by the FMU (README, "Exported symbols").
+    # that links it; never called by the FMU (docs/INTERNALS.md, "Exported symbols").
     assert other == ["callback_log"], other
 
 

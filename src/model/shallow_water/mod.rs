@@ -6,6 +6,7 @@
 
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
 use crate::description::vr;
+use crate::physics::laws::DampingLaw;
 use crate::physics::shallow_water::scheme::velocity;
 use crate::physics::shallow_water::{Channel, DRY, Flow, STAGE_COUNT, Scratch};
 use crate::solver::SolveStats;
@@ -33,6 +34,8 @@ pub struct ShallowWater {
     omega_1: f64,
     /// Damping ratio of the last step: the drag is 2 zeta omega_1 q.
     zeta: f64,
+    /// damping = Screens: its boundary layers' zeta, the drag's instead of the law's.
+    boundary: Option<f64>,
     /// Work of the inertial force on the liquid since the start [J] and the energy stored at
     /// the start [J] (which the damper counts as input).
     work: f64,
@@ -79,7 +82,13 @@ impl PartialEq for Storage {
 
 impl ShallowWater {
     fn drag(&self) -> f64 {
-        2.0 * self.zeta * self.omega_1
+        2.0 * self.linear_zeta(self.zeta) * self.omega_1
+    }
+
+    /// The damping ratio of the linear drag for the damping law's `zeta`: damping = Screens
+    /// gives its boundary layers' part only (the screens are resolved, not averaged).
+    fn linear_zeta(&self, zeta: f64) -> f64 {
+        self.boundary.unwrap_or(zeta)
     }
 
     /// Cell averages of cos (odd = false) or sin (true) of pi x/a.
@@ -114,7 +123,12 @@ impl Model for ShallowWater {
                  {DEEPEST} (twice the shallow-water limit 0.15)"
             ));
         }
-        let channel = Channel::new(t.length, t.depth, t.g, cells);
+        let mut channel = Channel::new(t.length, t.depth, t.g, cells);
+        let screens = &common.screens;
+        if screens.count > 0 {
+            channel =
+                channel.with_screens(&screens.positions(t.length), screens.loss_coefficient());
+        }
         let m1 = t.fundamental().mass;
         let rho_b = t.density * t.breadth;
         // The initial condition of the mechanical models' sloshing mass as the fundamental
@@ -152,6 +166,10 @@ impl Model for ShallowWater {
             m1,
             omega_1: t.fundamental().omega,
             zeta: start.zeta,
+            boundary: match common.damping {
+                DampingLaw::Screens { boundary, .. } => Some(boundary),
+                _ => None,
+            },
             work: 0.0,
             most: u64::from(p.count(vr::SOLVER_MAX_SUBSTEPS)),
             liquid: common.liquid_mass(),
@@ -167,9 +185,9 @@ impl Model for ShallowWater {
     /// Out of line: the steps of the other models stay small.
     #[inline(never)]
     fn step(&mut self, step: &Interval) -> Result<Stepped, StepError> {
+        let c = 2.0 * self.linear_zeta(step.zeta) * self.omega_1;
         let Storage { next, scratch } = &mut self.storage;
         next.clone_from(&self.flow);
-        let c = 2.0 * step.zeta * self.omega_1;
         let done = self
             .channel
             .advance_in(scratch, next, step.h, &step.base, c, self.most)
@@ -234,6 +252,11 @@ impl Model for ShallowWater {
         let c = self.drag();
         let dx = ch.dx();
         let n = ch.cells;
+        let dry = DRY * ch.depth;
+        let mut r = r;
+        if !ch.screens.is_empty() {
+            ch.screens.add_rates(h, q, &mut r.discharge, dry);
+        }
         let dq = |i: usize| r.discharge[i] - c * q[i];
         let momentum_rate = (0..n).map(dq).sum::<f64>() * dx;
         // Wall depths 1.5 H_0 - 0.5 H_1 (cut at 0) and their rates.
@@ -247,7 +270,6 @@ impl Model for ShallowWater {
         };
         let (dl, dr) = (wall_rate(left, 0, 1), wall_rate(right, n - 1, n - 2));
         let power_in = -a * r.mass_flux.iter().sum::<f64>() * dx;
-        let dry = DRY * ch.depth;
         let stored_rate = || {
             (0..n)
                 .map(|i| {
@@ -258,7 +280,15 @@ impl Model for ShallowWater {
                 * dx
         };
         match which {
-            Output::Force => self.scale * (ch.g_e * (right * dr - left * dl) + c * momentum_rate),
+            Output::Force => {
+                let force = ch.g_e * (right * dr - left * dl) + c * momentum_rate;
+                if ch.screens.is_empty() {
+                    self.scale * force
+                } else {
+                    let dq: Vec<f64> = (0..n).map(dq).collect();
+                    self.scale * (force + ch.screens.drag_rate(h, q, &r.depth, &dq, dry) * dx)
+                }
+            }
             Output::X => {
                 let mid = 0.5 * ch.length;
                 self.rho_b

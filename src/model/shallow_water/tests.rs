@@ -10,6 +10,19 @@ const SHALLOW_WATER: f64 = 5.0;
 const CONSTANT: f64 = 1.0;
 const BOUNDARY_LAYER: f64 = 3.0;
 const FIXED: f64 = 1.0;
+const SCREENS: f64 = 4.0;
+
+/// The arrangements both balance tests run with: none, and Tait's pair at 0.4 a and 0.6 a
+/// (S = 0.5) under damping = Screens (whose boundary-layer part is the drag).
+fn arrangements(p: StartValues) -> [StartValues; 2] {
+    let screened = p
+        .clone()
+        .with(vr::DAMPING, SCREENS)
+        .with(vr::SCREENS_COUNT, 2.0)
+        .with(vr::SCREENS_SOLIDITY, 0.5)
+        .with(vr::SCREENS_SPACING, 0.05);
+    [p, screened]
+}
 
 fn shallow(cells: f64) -> StartValues {
     StartValues::default()
@@ -39,8 +52,13 @@ fn harmonic(t: f64, w: f64, amplitude: f64) -> Inputs {
 /// stored + dissipated and dissipated never decreasing, through bores.
 #[test]
 fn outputs_keep_the_momentum_and_energy_balances() {
-    let p = shallow(40.0).with(vr::TANKS, 2.0);
-    let mut sim = damper(&p);
+    for p in arrangements(shallow(40.0).with(vr::TANKS, 2.0)) {
+        balances(&p);
+    }
+}
+
+fn balances(p: &StartValues) {
+    let mut sim = damper(p);
     let d = sim.derived();
     assert_eq!(d.mass_inactive, 0.0);
     let m1 = 2.0 * crate::physics::geometry::Tank::TABLE_2_1.fundamental().mass;
@@ -90,7 +108,13 @@ fn output_rates_are_the_outputs_derivatives() {
         .with(vr::ZETA, 0.05)
         .with(vr::SLOSH_X0, 0.01)
         .with(vr::SLOSH_V0, 0.02);
-    let mut sim = damper(&p);
+    for p in arrangements(p) {
+        rates(&p);
+    }
+}
+
+fn rates(p: &StartValues) {
+    let mut sim = damper(p);
     let inputs = Inputs {
         a: 0.3,
         ..Inputs::default()

@@ -81,6 +81,7 @@ macro_rules! builds {
 mod exact;
 mod lanes;
 pub mod scheme;
+pub mod screens;
 #[cfg(test)]
 mod tests;
 
@@ -88,6 +89,7 @@ use crate::physics::base::BaseAcceleration;
 use crate::solver::SolveError;
 use lanes::{Survey, decayed, faster, lane_sum, lane_sum_by, settle};
 use scheme::{Faces, Grid, March, Rates, rates, sweep_passes, velocity};
+use screens::ScreenCells;
 
 /// Courant number of a substep against the largest interface wave speed. The MUSCL-HLL
 /// forward-Euler stage keeps depths non-negative up to 1/2 (each cell average is the mean of
@@ -113,6 +115,8 @@ pub struct Channel {
     /// Gravity with the dispersion correction, g_e = g sigma [m/s^2].
     pub g_e: f64,
     pub cells: usize,
+    /// Damping screens ([`screens`]; none from [`Channel::new`]).
+    pub screens: ScreenCells,
 }
 
 impl Channel {
@@ -126,6 +130,15 @@ impl Channel {
             depth,
             g_e: g * k.tanh() / k,
             cells,
+            screens: ScreenCells::NONE,
+        }
+    }
+
+    /// This channel with screens of loss coefficient `c_l` at `positions` [m from x = 0].
+    pub fn with_screens(self, positions: &[f64], c_l: f64) -> Self {
+        Channel {
+            screens: ScreenCells::new(positions, c_l, self.dx(), self.cells),
+            ..self
         }
     }
 
@@ -201,10 +214,17 @@ impl Channel {
     }
 
     /// Force of the liquid on the tank per unit breadth and density [m^3/s^2], state only:
-    /// g_e (H(a)^2 - H(0)^2)/2 + c integral q dx with the extrapolated wall depths.
+    /// g_e (H(a)^2 - H(0)^2)/2 + c integral q dx with the extrapolated wall depths, plus the
+    /// screens' drag (C_l/2) q|q|/H at each.
     pub fn force(&self, f: &Flow, c: f64) -> f64 {
         let [l, r] = self.wall_depths(f);
-        0.5 * self.g_e * (r * r - l * l) + c * self.momentum(f)
+        let force = 0.5 * self.g_e * (r * r - l * l) + c * self.momentum(f);
+        if self.screens.is_empty() {
+            force
+        } else {
+            let dry = DRY * self.depth;
+            force + self.screens.drag(&f.depth, &f.discharge, dry) * self.dx()
+        }
     }
 
     /// The semi-discrete right-hand side at `f` under base acceleration `a` (no drag).
@@ -306,6 +326,11 @@ impl Channel {
         // U0 = the state after the first drag half: the depths are f's.
         let p0 = decayed(&f.discharge, &mut w.q0, decay);
         let mut impulse = drag_loss(p0 * dx);
+        // The screens' first half (after the drag's: each exact, Strang-symmetric overall).
+        let screens = !self.screens.is_empty();
+        if screens {
+            impulse += self.screens.apply(&f.depth, &mut w.q0, 0.5 * dt, grid.dry) * dx;
+        }
         let mut fastest: f64 = 0.0;
         let mut wall = 0.0;
         let mut work = 0.0;
@@ -359,6 +384,13 @@ impl Channel {
         impulse += wall;
         // The second drag half, then the films: a dry cell's discharge goes to the bottom.
         let dry = grid.dry;
+        // The screens' second half before the drag's (the halves mirror each other).
+        if screens {
+            impulse += self
+                .screens
+                .apply(&f.depth, &mut f.discharge, 0.5 * dt, dry)
+                * dx;
+        }
         // In one pass (vectorised): the drag, the momentum before it, the shallowest depth,
         // finiteness.
         let Survey {

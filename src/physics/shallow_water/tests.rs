@@ -95,6 +95,7 @@ fn dam_breaks_converge_to_ritter_and_stoker() {
                 depth: 0.1,
                 g_e: 9.81,
                 cells,
+                screens: super::screens::ScreenCells::NONE,
             };
             let mut f = ch.at_rest();
             for i in 0..cells {
@@ -506,6 +507,7 @@ fn bore_speed_and_loss_follow_rankine_hugoniot() {
         depth: 0.1,
         g_e: 9.81,
         cells: 400,
+        screens: super::screens::ScreenCells::NONE,
     };
     let x0 = 0.4;
     let mut f = ch.at_rest();
@@ -570,3 +572,6 @@ fn an_hour_of_violent_sloshing_conserves_mass() {
 /// The scheme's limits and edges: the dry depth and films, the CFL substeps and their retry,
 /// the step limit, the desingularised velocity, one and two cells, mirror symmetry.
 mod limits;
+
+/// Damping screens: closed-form equivalent damping, convergence, conservation.
+mod screens;

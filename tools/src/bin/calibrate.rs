@@ -75,6 +75,11 @@ struct Args {
     /// nsd_c=...,nsd_p=...,omega_f=...,worst_kappa_residual=...` comment with the fit)
     #[arg(long, value_name = "OUT")]
     csv: Option<String>,
+    /// write the fitted model and the NSD laws on 81 values of Lambda spaced logarithmically
+    /// over the samples' range as CSV to OUT (columns lambda,kappa_model,zeta_model,kappa_nsd,
+    /// zeta_nsd): the plot's curves
+    #[arg(long, value_name = "OUT")]
+    curve: Option<String>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -266,6 +271,24 @@ fn run(o: &Args) -> Result<(), String> {
             "# phi={},eta={},nsd_c={},nsd_p={},omega_f={wf},worst_kappa_residual={worst}\nlambda,kappa_data,kappa_model,zeta_data,zeta_model,kappa_nsd,zeta_nsd\n{rows}",
             fit.phi, fit.eta, fit.nsd_c, fit.nsd_p
         );
+        std::fs::write(path, text).map_err(|e| format!("cannot write {path}: {e}"))?;
+    }
+    if let Some(path) = &o.curve {
+        let (lo, hi) = samples.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), s| {
+            (lo.min(s.lambda), hi.max(s.lambda))
+        });
+        let mut text = String::from("lambda,kappa_model,zeta_model,kappa_nsd,zeta_nsd\n");
+        for k in 0..=80 {
+            let lambda = lo * (hi / lo).powf(f64::from(k) / 80.0);
+            let zeta = fit.nsd_c * lambda.powf(fit.nsd_p);
+            let model =
+                kappa_model(wf, tank.length, fit.phi, fit.eta, lambda, zeta).unwrap_or(f64::NAN);
+            text.push_str(&format!(
+                "{lambda},{model},{zeta},{},{}\n",
+                nsd_kappa(lambda),
+                0.5 * lambda.powf(0.35)
+            ));
+        }
         std::fs::write(path, text).map_err(|e| format!("cannot write {path}: {e}"))?;
     }
     Ok(())

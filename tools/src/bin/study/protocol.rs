@@ -103,11 +103,14 @@ impl Server {
                     .map(|run| {
                         fmu::take_messages();
                         match master::simulate(lib, &mut self.pool, run) {
+                            // the FMU's warnings of a run that succeeded go back with it: the
+                            // client shows them (a result built on a warned configuration)
                             Ok(o) => json!({
                                 "peak": o.peak,
                                 "steps": o.steps,
                                 "do_step_seconds": o.do_step_seconds,
                                 "instances": self.pool.instances.len(),
+                                "warnings": fmu::take_messages(),
                             }),
                             Err(e) => {
                                 let log = fmu::take_messages();
