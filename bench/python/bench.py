@@ -28,7 +28,8 @@ import numpy as np
 
 from tld_fmu.machine import git_info
 from tld_fmu.paths import FMU, REPO
-from tld_fmu.scenes import FmuInfo, compute_references, make_scenes, n_steps, rel_err, _stats
+from tld_fmu.scenes import (FmuInfo, check_scenes, compute_references, make_scenes, n_steps,
+                            rel_err, _stats)
 
 from workprec.baselines import build_pythonfmu, python_window, run_python, slave_for
 from workprec.formats import dt_label, fmt_ns
@@ -99,6 +100,11 @@ def main():
         stderr_lines += [f"[{sc.key} dt={dt:g}] {l}" for l in e]
     shutil.rmtree(tmp, ignore_errors=True)
     timings["native"] = time.perf_counter() - t0
+    # a scene its best run misses by far is broken (FMU and reference differ): said now, in the
+    # report's head and by the exit status
+    scene_failures = check_scenes(refs, rows)
+    for f in scene_failures:
+        print(f"scripts/bench: SCENE CHECK FAILED: {f}", file=sys.stderr, flush=True)
 
     t0 = time.perf_counter()
     pyfmu, pyfmu_note = build_pythonfmu(WORK)
@@ -143,7 +149,7 @@ def main():
     timings["_ref_computed"] = ref_computed
     tgt = write_report(args, scenes, refs, rows, stderr_lines, timings, out / "BENCHMARKS.md", img,
                        pyfmu_note, fi, xcheck,
-                       sweep_section(sweep_result) + swe_section(swe_result))
+                       sweep_section(sweep_result) + swe_section(swe_result), scene_failures)
     clean = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
     (img / "results.json").write_text(json.dumps(dict(
         timings=timings, targets=tgt, rows=clean, shallow_water=swe_result,
@@ -153,6 +159,10 @@ def main():
     print(f"wrote {out / 'BENCHMARKS.md'} and {img}/ in {timings['total']:.0f} s")
     for k, v in tgt["summary"].items():
         print(f"  target ({k}): {v}")
+    if scene_failures:
+        for f in scene_failures:
+            print(f"scripts/bench: SCENE CHECK FAILED: {f}", file=sys.stderr)
+        sys.exit(3)
 
 
 def only_study(args, fmu: Path, out: Path):

@@ -34,7 +34,7 @@ def run_native(fi: FmuInfo, sc: Scene, dt, a, refs, quick, tmp: Path):
         f = outdir / "input.f64"
         a.astype("<f8").tofile(f)
         lines.append(f"input {f} {n}")
-    phys = fi.physics_tokens(p) if sc.fmu_physics else []
+    phys = fi.scene_tokens(sc)
     meta = {}
     for method, setting, toks in fi.solver_settings(dt, quick, p.omega_f):
         rid = f"fmu_{method}_{setting}".replace("=", "").replace("+", "")
