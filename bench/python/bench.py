@@ -38,6 +38,7 @@ from workprec.plots import plots
 from workprec.report import write_report
 from workprec.sweep import sweep_section, sweep_throughput
 from workprec.swe import swe_cost, swe_section
+from workprec.latency import latency_cost, latency_section
 
 WORK = REPO / "target" / "bench"
 
@@ -53,6 +54,9 @@ def main():
                     "study-report: rewrite that section from the last measurement (bench/study.json)")
     ap.add_argument("--swe-only", action="store_true", help="only the shallow-water section: "
                     "print it and write it to target/bench/swe.md (BENCHMARKS.md untouched)")
+    ap.add_argument("--latency-only", action="store_true", help="only the step-time tails "
+                    "section: print it and write it to target/bench/latency.md (BENCHMARKS.md "
+                    "untouched)")
     args = ap.parse_args()
     from tqdm import tqdm
 
@@ -74,6 +78,13 @@ def main():
     if args.swe_only:
         section = "\n".join(swe_section(swe_cost(fi, args.quick, WORK)))
         (WORK / "swe.md").write_text(section)
+        print(section)
+        shutil.rmtree(fi.unzip, ignore_errors=True)
+        return
+
+    if args.latency_only:
+        section = "\n".join(latency_section(latency_cost(fi, args.quick, WORK)))
+        (WORK / "latency.md").write_text(section)
         print(section)
         shutil.rmtree(fi.unzip, ignore_errors=True)
         return
@@ -143,16 +154,22 @@ def main():
     timings["shallow water"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
+    latency_result = latency_cost(fi, args.quick, WORK)
+    timings["step-time tails"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
     plots(scenes, rows, img, "")
     timings["report"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     timings["_ref_computed"] = ref_computed
     tgt = write_report(args, scenes, refs, rows, stderr_lines, timings, out / "BENCHMARKS.md", img,
                        pyfmu_note, fi, xcheck,
-                       sweep_section(sweep_result) + swe_section(swe_result), scene_failures)
+                       sweep_section(sweep_result) + swe_section(swe_result)
+                       + latency_section(latency_result), scene_failures)
     clean = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
     (img / "results.json").write_text(json.dumps(dict(
         timings=timings, targets=tgt, rows=clean, shallow_water=swe_result,
+        step_time_tails=latency_result,
         scenes=[dict(key=s.key, title=s.title, T=s.T, dts=s.dts, describe=s.describe)
                 for s in scenes], sweep=sweep_result), indent=1, default=str))
     shutil.rmtree(fi.unzip, ignore_errors=True)

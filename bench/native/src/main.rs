@@ -20,6 +20,11 @@
 //! clock wall|cpu              what the runs below time: the wall clock (default) or the
 //!                             CPU time of the host's thread (not stretched by other
 //!                             processes on a loaded machine)
+//! latency on|off              open-loop runs below also time every step on its own (the
+//!                             wall clock, std::time::Instant; its own cost, some 20-40 ns, is
+//!                             in every figure) and print
+//!                             `latency ID median_ns p99_ns p9999_ns max_ns` over the steps of
+//!                             all repeats
 //! ```
 //!
 //! Each run is repeated R times on a fresh instance; only the stepping loop is timed
@@ -143,6 +148,47 @@ struct Coupled {
     sub: u32,
     n: usize,
     m0: f64,
+}
+
+/// Open-loop scene with every step timed on its own (wall clock): the loop of [`run_open`]
+/// with a clock read between steps, the step times (ns) in `per_step`.
+fn run_open_per_step<D: Damper>(
+    d: &mut D,
+    a: &[f64],
+    dt: f64,
+    per_step: &mut Vec<u32>,
+) -> RunResult {
+    let n = a.len();
+    let mut xs = vec![0.0; n + 1];
+    let o = d.outputs().map_err(|e| (0, e))?;
+    xs[0] = o[0];
+    per_step.reserve(n);
+    let t0 = Instant::now();
+    let mut last = t0;
+    for k in 0..n {
+        let o = d.step(k as f64 * dt, dt, a[k]).map_err(|e| (k, e))?;
+        xs[k + 1] = o[0];
+        let now = Instant::now();
+        per_step.push(u32::try_from((now - last).as_nanos()).unwrap_or(u32::MAX));
+        last = now;
+    }
+    Ok(Run {
+        ns: t0.elapsed().as_nanos(),
+        x: xs,
+        big_x: vec![],
+        force: vec![],
+    })
+}
+
+/// (median, 99th, 99.99th percentile, max) of the step times, nearest rank.
+fn tails(times: &mut [u32]) -> [u32; 4] {
+    times.sort_unstable();
+    let n = times.len();
+    if n == 0 {
+        return [0; 4];
+    }
+    let rank = |q: f64| times[((q * n as f64).ceil() as usize).clamp(1, n) - 1];
+    [rank(0.5), rank(0.99), rank(0.9999), times[n - 1]]
 }
 
 /// Open-loop scene: base.a[k] held over step k. Returns (elapsed ns, x history, force history).
@@ -289,6 +335,7 @@ struct Settings {
     outdir: String,
     model: Option<Model>,
     clock: Clock,
+    latency: bool,
 }
 
 enum Kind {
@@ -297,8 +344,9 @@ enum Kind {
     Dp45(f64),
 }
 
-/// One repeat of a run: fresh damper, timed loop.
-fn once(st: &Settings, kind: &Kind) -> RunResult {
+/// One repeat of a run: fresh damper, timed loop (each step's time added to `per_step` when
+/// the settings ask for it, open-loop FMU runs only).
+fn once(st: &Settings, kind: &Kind, per_step: &mut Vec<u32>) -> RunResult {
     let e0 = |e: String| (0usize, e);
     match kind {
         Kind::Fmu(params) => {
@@ -310,6 +358,7 @@ fn once(st: &Settings, kind: &Kind) -> RunResult {
                     let m0 = inst.mass_inactive().map_err(e0)?;
                     run_coupled(&mut inst, c, m0, st.dt, st.clock)
                 }
+                None if st.latency => run_open_per_step(&mut inst, &st.input, st.dt, per_step),
                 None => run_open(&mut inst, &st.input, st.dt, st.clock),
             }
         }
@@ -411,6 +460,13 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                     other => return Err(err(format!("clock {other:?}: wall or cpu"))),
                 }
             }
+            "latency" => {
+                st.latency = match tok.get(1).copied() {
+                    Some("on") => true,
+                    Some("off") => false,
+                    other => return Err(err(format!("latency {other:?}: on or off"))),
+                }
+            }
             "model" => {
                 let m = kv(&tok[1..]);
                 let g = |k: &str| num(&m, k);
@@ -461,8 +517,9 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                 let mut times = Vec::new();
                 let mut first: Option<Run> = None;
                 let mut failure = None;
+                let mut per_step = Vec::new();
                 for _ in 0..st.repeats.max(1) {
-                    match once(&st, &kind) {
+                    match once(&st, &kind, &mut per_step) {
                         Ok(run) => {
                             times.push(run.ns);
                             if first.is_none() {
@@ -493,6 +550,10 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                         }
                         if !force.is_empty() {
                             write_f64(&format!("{}/{id}.f.f64", st.outdir), &force).map_err(err)?;
+                        }
+                        if !per_step.is_empty() {
+                            let [median, p99, p9999, max] = tails(&mut per_step);
+                            writeln!(out, "latency {id} {median} {p99} {p9999} {max}").ok();
                         }
                         let all: Vec<String> = times.iter().map(|t| t.to_string()).collect();
                         let med = median(&mut times.clone());
