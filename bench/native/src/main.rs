@@ -4,7 +4,8 @@
 //! line; settings lines configure, `run` lines execute:
 //!
 //! ```text
-//! lib PATH                    the FMU's binaries/linux64/TLD.so
+//! lib PATH                    the FMU's binaries/linux64/TLD.so (another `lib` line: the
+//!                             `fmu` runs after it drive that library, e.g. bench/c's C FMU)
 //! guid GUID
 //! vrs base_a=50 x=63 v=64 force=60 mass_inactive=43
 //! input PATH N                N f64 (little endian): base.a held over step k (open-loop scenes)
@@ -418,7 +419,11 @@ fn real_main(jobfile: &str) -> Result<(), String> {
         }
         let err = |e: String| format!("{jobfile}:{}: {e}", lineno + 1);
         match tok[0] {
-            "lib" => st.lib_path = tok[1].to_string(),
+            "lib" => {
+                // the runs below load this library (a job may time several FMUs in turn)
+                st.lib_path = tok[1].to_string();
+                st.lib = None;
+            }
             "guid" => st.guid = tok[1].to_string(),
             "vrs" => {
                 let m = kv(&tok[1..]);

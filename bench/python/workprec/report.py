@@ -67,12 +67,19 @@ def write_report(args, scenes, refs, rows, stderr_lines, timings, out_md: Path, 
         "`std::time::Instant`; each run is repeated (5×; 3× for runs of more than 10⁶ steps) on a fresh "
         "instance and the **median** is reported, as ns per doStep and ns per simulated second.")
     L.append(
-        "* **Plain-Rust baseline** (`bench/native/src/baseline.rs`, no FMI layer, the \"careful C "
-        "FMU\"): the same Eq 2.11 with constant zeta (2 states; `powi` for integer 2η−2), stepped "
+        "* **Plain-Rust baseline** (`bench/native/src/baseline.rs`, no FMI layer): "
+        "the same Eq 2.11 with constant zeta (2 states; `powi` for integer 2η−2), stepped "
         "per communication step with the input held, by (a) RK4 with n equal substeps and (b) "
         "Dormand–Prince 5(4) with error control (mixed error norm rtol·(a/2 + |x|), rtol·(ω_f a/2 "
         "+ |v|), the FMU's scales; step size carried across communication steps). Timed in the "
         "same loop, same repeats, same scenes, same error measure.")
+    L.append(
+        "* **Careful C FMU** (`bench/c/tld_c.c`, gcc -O2, written for the benchmark from MODEL.md): "
+        "the same Eq 2.11 with constant zeta behind the same FMI 2.0 calls and value references, "
+        "values checked as set, steps all or nothing; RK4 with n equal substeps and "
+        "Dormand–Prince 5(4) with the same error norm and carried step size as the plain-Rust "
+        "baseline (its histories equal the baseline's bit for bit). Driven by the same "
+        "`tld-bench` loop as TLD.fmu, in the same job.")
     L.append(
         "* **Python baselines** cost 10⁴–10⁵× more per step, so they run on a **window** at the "
         "start of each scene (min(T, 20 s) and at most "
@@ -188,8 +195,8 @@ def write_report(args, scenes, refs, rows, stderr_lines, timings, out_md: Path, 
                      "| steps |")
             L.append("|---|---|---|---|---|---|---|---|")
             rs = [r for r in rows if r["scene"] == sc.key and r["dt"] == dt]
-            order = {"TLD.fmu": 0, "Rust baseline": 1, "scipy solve_ivp": 2, "pythonfmu": 3,
-                     "TLD.fmu via fmpy": 4}
+            order = {"TLD.fmu": 0, "C FMU": 1, "Rust baseline": 2, "scipy solve_ivp": 3,
+                     "pythonfmu": 4, "TLD.fmu via fmpy": 5}
             for r in sorted(rs, key=lambda r: (order.get(r["impl"], 9), r["method"])):
                 meth = r["method"] + (" (**default settings**)" if r["method"] == "default" else "")
                 if r["status"] != "ok":
