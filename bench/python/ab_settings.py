@@ -12,6 +12,9 @@ RK4 with one substep (Tracked and Fixed), DormandPrince45 at 1e-12 (tight, Track
 and the defaults with damping = NSD (where the tracker is read every step). --base: a built
 library, or a git revision built as bench/python/ab.py does. --now: default the working tree's
 release library (built first). The value references come from modelDescription/modelDescription.xml.
+The careful C FMU (bench/c/tld_c.c, compiled with gcc -O2) runs in the same rounds as the "now"
+build: RK4 with one substep (the same arithmetic and error as TLD.fmu's) and DormandPrince45 at
+the same tolerances (not the same error: BENCHMARKS.md compares the fronts at equal error).
 """
 from __future__ import annotations
 
@@ -76,7 +79,17 @@ def cases(d: Description):
             ("NSD_defaults", nsd)]
 
 
-def job(d: Description, lib: Path, tmp: Path, steps: int) -> Path:
+def c_cases(d: Description):
+    """[(name, tokens)]: the careful C FMU (bench/c/tld_c.c) on the same scene: RK4 with one
+    substep, DormandPrince45 at TLD.fmu's default tolerance and at the tight one."""
+    phys = [d.token("eta", 2.0), d.token("phi", 1.0), d.token("damping", "Constant"),
+            d.token("zeta", 0.02)]
+    return [("C_RK4_n1", phys + [d.token("solver", "RK4"), d.token("solver.fixed_step", 1e-3)]),
+            ("C_DP45_1e-10", phys + [d.token("solver.tolerance", 1e-10)]),
+            ("C_DP45_1e-12", phys + [d.token("solver.tolerance", 1e-12)])]
+
+
+def job(d: Description, lib: Path, tmp: Path, steps: int, c_lib: Path | None = None) -> Path:
     wf = math.sqrt(math.pi * 9.81 / 0.25 * math.tanh(math.pi * 0.021 / 0.25))
     w, amp, dt = 1.05 * wf, 0.003, 1e-3
     a = -w * w * amp * np.sin(w * dt * np.arange(steps))
@@ -92,6 +105,10 @@ def job(d: Description, lib: Path, tmp: Path, steps: int) -> Path:
     tag = lib.name.replace(".", "_")
     for name, toks in cases(d):
         lines.append(f"run {name} fmu {' '.join(toks)}")
+    if c_lib is not None:
+        lines.append(f"lib {c_lib}")
+        for name, toks in c_cases(d):
+            lines.append(f"run {name} fmu {' '.join(toks)}")
     path = tmp / f"{tag}.job"
     path.write_text("\n".join(lines) + "\n")
     return path
@@ -113,13 +130,20 @@ def main(argv=None):
     tmp = Path(tempfile.mkdtemp(prefix="tld_ab_settings_"))
     (tmp / "base").mkdir()
     (tmp / "now").mkdir()
-    jobs = {"base": job(d, base, tmp / "base", args.steps), "now": job(d, now, tmp / "now", args.steps)}
+    c_lib = tmp / "tld_c.so"
+    subprocess.run(["gcc", "-O2", "-shared", "-fPIC", "-o", str(c_lib),
+                    str(REPO / "bench" / "c" / "tld_c.c"), "-lm"], check=True)
+    # the C FMU runs in the "now" job: timed in the same rounds
+    jobs = {"base": job(d, base, tmp / "base", args.steps),
+            "now": job(d, now, tmp / "now", args.steps, c_lib)}
     names = [n for n, _ in cases(d)]
-    times = {k: {n: [] for n in names} for k in jobs}
+    c_names = [n for n, _ in c_cases(d)]
+    times = {k: {n: [] for n in names + c_names} for k in jobs}
     for _ in tqdm(range(args.rounds), desc="A/B rounds"):
         for k in jobs:
             for n, t in run(jobs[k]).items():
                 times[k][n].append(t)
+    times["base"] = {n: v for n, v in times["base"].items() if v}
     # the histories of both builds, bit for bit
     same = {n: (tmp / "base" / f"{n}.x.f64").read_bytes() == (tmp / "now" / f"{n}.x.f64").read_bytes()
             for n in names}
@@ -133,10 +157,19 @@ def main(argv=None):
              f"{args.steps:,} steps, CPU time of the host's thread (fmi2SetReal + fmi2DoStep + fmi2GetReal of 3 outputs).", "",
              "| case | base ns/step | now ns/step | now/base | slosh.x bit-identical |",
              "|---|---|---|---|---|"]
-    med = {k: {n: statistics.median(times[k][n]) for n in names} for k in jobs}
+    med = {k: {n: statistics.median(v) for n, v in times[k].items()} for k in jobs}
     for n in names:
         b, w = med["base"][n], med["now"][n]
         lines.append(f"| {n} | {b:.1f} | {w:.1f} | {w / b:.3f} | {'yes' if same[n] else 'NO'} |")
+    c = med["now"]
+    pairs = [("RK4_n1_Fixed", "C_RK4_n1", "RK4, one substep, the same error"),
+             ("defaults_Fixed", "C_DP45_1e-10", "DormandPrince45 at 1e-10 (TLD.fmu's default)"),
+             ("defaults", "C_DP45_1e-10", "TLD.fmu's defaults (Tracked) against the C FMU's DP45 at 1e-10"),
+             ("tight_Fixed", "C_DP45_1e-12", "DormandPrince45 at 1e-12")]
+    lines += ["", "The careful C FMU (bench/c/tld_c.c, gcc -O2) in the same rounds:", "",
+              "| case | TLD.fmu now ns/step | C FMU ns/step | TLD.fmu / C |", "|---|---|---|---|"]
+    for a, b, what in pairs:
+        lines.append(f"| {what} | {c[a]:.1f} | {c[b]:.1f} | {c[a] / c[b]:.2f} |")
     lines.append("")
     for k in jobs:
         for n in ("defaults", "RK4_n1", "tight"):
