@@ -75,16 +75,13 @@ def main():
     fi.path = Path(args.fmu)
     print(f"FMU {args.fmu} (sha256 {fi.sha256[:16]}), solver items: "
           + ", ".join(f"{n}={v}" for n, v, _ in fi.items("solver")), flush=True)
-    if args.swe_only:
-        section = "\n".join(swe_section(swe_cost(fi, args.quick, WORK)))
-        (WORK / "swe.md").write_text(section)
-        print(section)
-        shutil.rmtree(fi.unzip, ignore_errors=True)
-        return
-
-    if args.latency_only:
-        section = "\n".join(latency_section(latency_cost(fi, args.quick, WORK)))
-        (WORK / "latency.md").write_text(section)
+    # one section alone: printed and written to target/bench/<name>.md
+    alone = {"swe": (swe_cost, swe_section), "latency": (latency_cost, latency_section)}
+    name = "swe" if args.swe_only else "latency" if args.latency_only else None
+    if name:
+        cost, write = alone[name]
+        section = "\n".join(write(cost(fi, args.quick, WORK)))
+        (WORK / f"{name}.md").write_text(section)
         print(section)
         shutil.rmtree(fi.unzip, ignore_errors=True)
         return
