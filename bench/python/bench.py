@@ -55,8 +55,8 @@ def main():
     ap.add_argument("--swe-only", action="store_true", help="only the shallow-water section: "
                     "print it and write it to target/bench/swe.md (BENCHMARKS.md untouched)")
     ap.add_argument("--latency-only", action="store_true", help="only the step-time tails "
-                    "section: print it and write it to target/bench/latency.md (BENCHMARKS.md "
-                    "untouched)")
+                    "section: print it, write it to target/bench/latency.md and (without --quick) "
+                    "put it in place of the report's")
     args = ap.parse_args()
     from tqdm import tqdm
 
@@ -80,10 +80,17 @@ def main():
     name = "swe" if args.swe_only else "latency" if args.latency_only else None
     if name:
         cost, write = alone[name]
-        section = "\n".join(write(cost(fi, args.quick, WORK)))
+        lines = write(cost(fi, args.quick, WORK))
+        section = "\n".join(lines)
         (WORK / f"{name}.md").write_text(section)
         print(section)
         shutil.rmtree(fi.unzip, ignore_errors=True)
+        if name == "latency" and not args.quick:
+            # measured anew: in place of the report's section, saying when and on what
+            lines[2:2] = [f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} by "
+                          f"`scripts/bench --latency-only` on {git_info()}.", ""]
+            replace_section(out / "BENCHMARKS.md", lines)
+            print(f"wrote {out / 'BENCHMARKS.md'} (its step-time tails section)")
         return
 
     scenes = make_scenes(args.quick)
@@ -179,6 +186,19 @@ def main():
         sys.exit(3)
 
 
+def replace_section(md: Path, section: list[str]):
+    """Put `section` (its first line the heading) in place of the report's section of that
+    heading, or before "## Reproduce" when the report has none."""
+    text = md.read_text() if md.exists() else "# TLD.fmu work-precision benchmark\n\n## Reproduce\n"
+    lines = text.split("\n")
+    start = next((i for i, l in enumerate(lines) if l == section[0]), None)
+    if start is None:
+        start = end = next(i for i, l in enumerate(lines) if l.startswith("## Reproduce"))
+    else:
+        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
+    md.write_text("\n".join(lines[:start] + section + lines[end:]))
+
+
 def only_study(args, fmu: Path, out: Path):
     """--only study: the design-study section measured anew and put in place of the report's;
     --only study-report: the section written again from the last measurement."""
@@ -194,15 +214,7 @@ def only_study(args, fmu: Path, out: Path):
     section = sweep_section(res)
     section[2:2] = [res.get("measured", ""), ""]
     md = out / "BENCHMARKS.md"
-    text = md.read_text() if md.exists() else "# TLD.fmu work-precision benchmark\n\n## Reproduce\n"
-    head = "## Design-study throughput"
-    lines = text.split("\n")
-    start = next((i for i, l in enumerate(lines) if l.startswith(head)), None)
-    if start is None:
-        start = end = next(i for i, l in enumerate(lines) if l.startswith("## Reproduce"))
-    else:
-        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
-    md.write_text("\n".join(lines[:start] + section + lines[end:]))
+    replace_section(md, section)
     saved.parent.mkdir(parents=True, exist_ok=True)
     saved.write_text(json.dumps(res, indent=1, default=str))
     print("\n".join(section))

@@ -21,9 +21,10 @@
 //! clock wall|cpu              what the runs below time: the wall clock (default) or the
 //!                             CPU time of the host's thread (not stretched by other
 //!                             processes on a loaded machine)
-//! latency on|off              open-loop runs below also time every step on its own (the
-//!                             wall clock, std::time::Instant; its own cost, some 20-40 ns, is
-//!                             in every figure) and print
+//! latency on|off              open-loop runs below also time every step on its own (by the
+//!                             `clock`: the wall clock, std::time::Instant, whose own cost, some
+//!                             20-40 ns, is in every figure; or the thread's CPU time, a system
+//!                             call of some 100s of ns, which preemption does not stretch) and print
 //!                             `latency ID median_ns p99_ns p9999_ns max_ns` over the steps of
 //!                             all repeats
 //! ```
@@ -151,12 +152,13 @@ struct Coupled {
     m0: f64,
 }
 
-/// Open-loop scene with every step timed on its own (wall clock): the loop of [`run_open`]
+/// Open-loop scene with every step timed on its own by `clock`: the loop of [`run_open`]
 /// with a clock read between steps, the step times (ns) in `per_step`.
 fn run_open_per_step<D: Damper>(
     d: &mut D,
     a: &[f64],
     dt: f64,
+    clock: Clock,
     per_step: &mut Vec<u32>,
 ) -> RunResult {
     let n = a.len();
@@ -164,17 +166,17 @@ fn run_open_per_step<D: Damper>(
     let o = d.outputs().map_err(|e| (0, e))?;
     xs[0] = o[0];
     per_step.reserve(n);
-    let t0 = Instant::now();
-    let mut last = t0;
+    let t0 = Stopwatch::start(clock);
+    let mut last = t0.ns();
     for k in 0..n {
         let o = d.step(k as f64 * dt, dt, a[k]).map_err(|e| (k, e))?;
         xs[k + 1] = o[0];
-        let now = Instant::now();
-        per_step.push(u32::try_from((now - last).as_nanos()).unwrap_or(u32::MAX));
+        let now = t0.ns();
+        per_step.push(u32::try_from(now.saturating_sub(last)).unwrap_or(u32::MAX));
         last = now;
     }
     Ok(Run {
-        ns: t0.elapsed().as_nanos(),
+        ns: t0.ns(),
         x: xs,
         big_x: vec![],
         force: vec![],
@@ -360,7 +362,9 @@ fn once(st: &Settings, kind: &Kind, per_step: &mut Vec<u32>) -> RunResult {
                     let m0 = inst.mass_inactive().map_err(e0)?;
                     run_coupled(&mut inst, c, m0, st.dt, st.clock)
                 }
-                None if st.latency => run_open_per_step(&mut inst, &st.input, st.dt, per_step),
+                None if st.latency => {
+                    run_open_per_step(&mut inst, &st.input, st.dt, st.clock, per_step)
+                }
                 None => run_open(&mut inst, &st.input, st.dt, st.clock),
             }
         }
