@@ -2,9 +2,10 @@
  * counts fmi2DoStep inclusive and the whole SetReal/DoStep/GetReal loop.
  *
  *   step_host <library> <GUID> <steps> <input vr> <output vr> [<Integer vr>=<value> ...]
+ *             [R:<Real vr>=<value> ...] [H=<communication step>]
  *
- * Instantiates, sets the Integer parameters (e.g. TLD's model), initialises, then per step sets
- * the input to a harmonic value, steps by 0.01 s and reads the output. */
+ * Instantiates, sets the Integer parameters (e.g. TLD's model) and Real ones, initialises, then per step sets
+ * the input to a harmonic value, steps by 0.01 s (or H) and reads the output. */
 #include <dlfcn.h>
 #include <math.h>
 #include <stdio.h>
@@ -46,12 +47,19 @@ int main(int argc, char **argv) {
     int steps = atoi(argv[3]);
     unsigned in = (unsigned)atoi(argv[4]), out = (unsigned)atoi(argv[5]);
     if (setup(c, 0, 0.0, 0.0, 0, 0.0) || enter(c)) return 1;
+    double h = 0.01;
     for (int i = 6; i < argc; i++) {
-        unsigned vr; int value;
-        if (sscanf(argv[i], "%u=%d", &vr, &value) != 2 || set_integer(c, &vr, 1, &value)) return 1;
+        unsigned vr; int value; double real;
+        if (sscanf(argv[i], "H=%lf", &real) == 1) {
+            h = real;
+        } else if (sscanf(argv[i], "R:%u=%lf", &vr, &real) == 2) {
+            if (set_real(c, &vr, 1, &real)) return 1;
+        } else if (sscanf(argv[i], "%u=%d", &vr, &value) != 2 || set_integer(c, &vr, 1, &value)) {
+            return 1;
+        }
     }
     if (exit_(c)) return 1;
-    double t = 0.0, h = 0.01, y = 0.0, sum = 0.0;
+    double t = 0.0, y = 0.0, sum = 0.0;
     for (int k = 0; k < steps; k++) {
         double a = 0.5 * sin(5.0 * t);
         if (set_real(c, &in, 1, &a) || do_step(c, t, h, 1) || get_real(c, &out, 1, &y)) return 1;

@@ -28,7 +28,8 @@ import numpy as np
 
 from tld_fmu.machine import git_info
 from tld_fmu.paths import FMU, REPO
-from tld_fmu.scenes import FmuInfo, compute_references, make_scenes, n_steps, rel_err, _stats
+from tld_fmu.scenes import (FmuInfo, check_scenes, compute_references, make_scenes, n_steps,
+                            rel_err, _stats)
 
 from workprec.baselines import build_pythonfmu, python_window, run_python, slave_for
 from workprec.formats import dt_label, fmt_ns
@@ -37,6 +38,7 @@ from workprec.plots import plots
 from workprec.report import write_report
 from workprec.sweep import sweep_section, sweep_throughput
 from workprec.swe import swe_cost, swe_section
+from workprec.latency import latency_cost, latency_section
 
 WORK = REPO / "target" / "bench"
 
@@ -52,6 +54,9 @@ def main():
                     "study-report: rewrite that section from the last measurement (bench/study.json)")
     ap.add_argument("--swe-only", action="store_true", help="only the shallow-water section: "
                     "print it and write it to target/bench/swe.md (BENCHMARKS.md untouched)")
+    ap.add_argument("--latency-only", action="store_true", help="only the step-time tails "
+                    "section: print it, write it to target/bench/latency.md and (without --quick) "
+                    "put it in place of the report's")
     args = ap.parse_args()
     from tqdm import tqdm
 
@@ -70,11 +75,22 @@ def main():
     fi.path = Path(args.fmu)
     print(f"FMU {args.fmu} (sha256 {fi.sha256[:16]}), solver items: "
           + ", ".join(f"{n}={v}" for n, v, _ in fi.items("solver")), flush=True)
-    if args.swe_only:
-        section = "\n".join(swe_section(swe_cost(fi, args.quick, WORK)))
-        (WORK / "swe.md").write_text(section)
+    # one section alone: printed and written to target/bench/<name>.md
+    alone = {"swe": (swe_cost, swe_section), "latency": (latency_cost, latency_section)}
+    name = "swe" if args.swe_only else "latency" if args.latency_only else None
+    if name:
+        cost, write = alone[name]
+        lines = write(cost(fi, args.quick, WORK))
+        section = "\n".join(lines)
+        (WORK / f"{name}.md").write_text(section)
         print(section)
         shutil.rmtree(fi.unzip, ignore_errors=True)
+        if name == "latency" and not args.quick:
+            # measured anew: in place of the report's section, saying when and on what
+            lines[2:2] = [f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} by "
+                          f"`scripts/bench --latency-only` on {git_info()}.", ""]
+            replace_section(out / "BENCHMARKS.md", lines)
+            print(f"wrote {out / 'BENCHMARKS.md'} (its step-time tails section)")
         return
 
     scenes = make_scenes(args.quick)
@@ -99,6 +115,11 @@ def main():
         stderr_lines += [f"[{sc.key} dt={dt:g}] {l}" for l in e]
     shutil.rmtree(tmp, ignore_errors=True)
     timings["native"] = time.perf_counter() - t0
+    # a scene its best run misses by far is broken (FMU and reference differ): said now, in the
+    # report's head and by the exit status
+    scene_failures = check_scenes(refs, rows)
+    for f in scene_failures:
+        print(f"scripts/bench: SCENE CHECK FAILED: {f}", file=sys.stderr, flush=True)
 
     t0 = time.perf_counter()
     pyfmu, pyfmu_note = build_pythonfmu(WORK)
@@ -137,22 +158,45 @@ def main():
     timings["shallow water"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
+    latency_result = latency_cost(fi, args.quick, WORK)
+    timings["step-time tails"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
     plots(scenes, rows, img, "")
     timings["report"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     timings["_ref_computed"] = ref_computed
     tgt = write_report(args, scenes, refs, rows, stderr_lines, timings, out / "BENCHMARKS.md", img,
                        pyfmu_note, fi, xcheck,
-                       sweep_section(sweep_result) + swe_section(swe_result))
+                       sweep_section(sweep_result) + swe_section(swe_result)
+                       + latency_section(latency_result), scene_failures)
     clean = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
     (img / "results.json").write_text(json.dumps(dict(
         timings=timings, targets=tgt, rows=clean, shallow_water=swe_result,
+        step_time_tails=latency_result,
         scenes=[dict(key=s.key, title=s.title, T=s.T, dts=s.dts, describe=s.describe)
                 for s in scenes], sweep=sweep_result), indent=1, default=str))
     shutil.rmtree(fi.unzip, ignore_errors=True)
     print(f"wrote {out / 'BENCHMARKS.md'} and {img}/ in {timings['total']:.0f} s")
     for k, v in tgt["summary"].items():
         print(f"  target ({k}): {v}")
+    if scene_failures:
+        for f in scene_failures:
+            print(f"scripts/bench: SCENE CHECK FAILED: {f}", file=sys.stderr)
+        sys.exit(3)
+
+
+def replace_section(md: Path, section: list[str]):
+    """Put `section` (its first line the heading) in place of the report's section of that
+    heading, or before "## Reproduce" when the report has none."""
+    text = md.read_text() if md.exists() else "# TLD.fmu work-precision benchmark\n\n## Reproduce\n"
+    lines = text.split("\n")
+    start = next((i for i, l in enumerate(lines) if l == section[0]), None)
+    if start is None:
+        start = end = next(i for i, l in enumerate(lines) if l.startswith("## Reproduce"))
+    else:
+        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
+    md.write_text("\n".join(lines[:start] + section + lines[end:]))
 
 
 def only_study(args, fmu: Path, out: Path):
@@ -170,15 +214,7 @@ def only_study(args, fmu: Path, out: Path):
     section = sweep_section(res)
     section[2:2] = [res.get("measured", ""), ""]
     md = out / "BENCHMARKS.md"
-    text = md.read_text() if md.exists() else "# TLD.fmu work-precision benchmark\n\n## Reproduce\n"
-    head = "## Design-study throughput"
-    lines = text.split("\n")
-    start = next((i for i, l in enumerate(lines) if l.startswith(head)), None)
-    if start is None:
-        start = end = next(i for i, l in enumerate(lines) if l.startswith("## Reproduce"))
-    else:
-        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
-    md.write_text("\n".join(lines[:start] + section + lines[end:]))
+    replace_section(md, section)
     saved.parent.mkdir(parents=True, exist_ok=True)
     saved.write_text(json.dumps(res, indent=1, default=str))
     print("\n".join(section))

@@ -21,8 +21,13 @@ pub struct Damper {
     derived: Derived,
     model: AnyModel,
     tracker: Option<AmplitudeTracker>,
+    /// Whether the damping law reads the amplitude: only then is a tracked amplitude estimated
+    /// before each step. Otherwise the tracker only takes in the step's input, and its estimate
+    /// is formed when something reads it (A_e.estimate, a saved state).
+    damping_reads_amplitude: bool,
     /// Stored energy at the start [J]: counted as input.
     initial_energy: f64,
+    /// The fixed amplitude, or a tracked one's prior (see [`Damper::amplitude`]).
     amplitude: f64,
     /// Damping ratio in use.
     zeta: f64,
@@ -80,6 +85,7 @@ impl Damper {
             per_step: per_step(&model),
             model,
             tracker,
+            damping_reads_amplitude: common.damping.reads_amplitude(),
             amplitude,
             zeta,
             last_mean_force: None,
@@ -98,9 +104,18 @@ impl Damper {
     /// this would add costs more than its body.
     #[inline(always)]
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
-        // Only a tracked amplitude moves the damping; a fixed one was applied in configure.
+        // Only a tracked amplitude that the damping law reads moves the damping; a fixed one
+        // was applied in configure.
         match &self.tracker {
             None => self.advance(self.zeta, t, h, inputs),
+            Some(_) if !self.damping_reads_amplitude => {
+                // The tracker takes in the input once the step has succeeded (all or nothing).
+                let report = self.advance(self.zeta, t, h, inputs)?;
+                if let Some(tracker) = self.tracker.as_mut() {
+                    tracker.update(h, inputs.a, inputs.v);
+                }
+                Ok(report)
+            }
             Some(tracker) => {
                 let mut tracker = tracker.clone();
                 tracker.update(h, inputs.a, inputs.v);
@@ -109,7 +124,8 @@ impl Damper {
         }
     }
 
-    /// [`Damper::step`] with the amplitude tracker as it will be after the step.
+    /// [`Damper::step`] with the amplitude tracker as it will be after the step, for a damping
+    /// law that reads the amplitude.
     #[inline(never)]
     fn step_tracked(
         &mut self,
@@ -119,9 +135,16 @@ impl Damper {
         inputs: &Inputs,
     ) -> Result<Report, StepError> {
         let report = self.advance(self.common.zeta(tracker.estimate()), t, h, inputs)?;
-        self.amplitude = tracker.estimate();
         self.tracker = Some(tracker);
         Ok(report)
+    }
+
+    /// The excitation amplitude the damping law is given (A_e.estimate): the fixed one, or
+    /// the tracker's estimate from the input so far (its prior before the first step).
+    pub fn amplitude(&self) -> f64 {
+        self.tracker
+            .as_ref()
+            .map_or(self.amplitude, AmplitudeTracker::estimate)
     }
 
     /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker. Small
@@ -229,7 +252,7 @@ impl Damper {
             Output::EnergyInput => self.initial_energy + observe(Observable::WorkIn),
             Output::EnergyDissipated => observe(Observable::Dissipated),
             Output::EnergyStored => observe(Observable::Stored),
-            Output::Amplitude => self.amplitude,
+            Output::Amplitude => self.amplitude(),
             Output::Zeta => self.zeta,
             Output::ImpactZ => observe(Observable::ImpactZ),
             Output::Impacts => observe(Observable::Impacts),
@@ -276,7 +299,7 @@ impl Damper {
     pub fn snapshot(&self) -> Vec<f64> {
         let mut out = Vec::with_capacity(self.model.state_len() + FRAME);
         self.model.save(&mut out);
-        out.push(self.amplitude);
+        out.push(self.amplitude());
         out.push(f64::from(u8::from(self.last_mean_force.is_some())));
         out.push(self.last_mean_force.unwrap_or(0.0));
         out.extend_from_slice(
@@ -304,7 +327,11 @@ impl Damper {
         }
         let (model_state, frame) = snapshot.split_at(n);
         damper.model.load(model_state)?;
-        damper.amplitude = frame[0];
+        // A tracked amplitude is the tracker's estimate (frame[0] holds it as saved); a fixed
+        // one is the state's.
+        if damper.tracker.is_none() {
+            damper.amplitude = frame[0];
+        }
         damper.last_mean_force = match frame[1] {
             0.0 => None,
             1.0 => Some(frame[2]),
@@ -316,7 +343,7 @@ impl Damper {
             tracker.set_state(&t)?;
         }
         // The damping the last step used, which the model keeps for the output rates.
-        damper.zeta = damper.common.zeta(damper.amplitude);
+        damper.zeta = damper.common.zeta(damper.amplitude());
         damper.model.set_damping(damper.zeta);
         damper.per_step = per_step(&damper.model);
         Ok(damper)

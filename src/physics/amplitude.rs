@@ -25,7 +25,30 @@ impl MeanSquare {
 /// Number of values in [`AmplitudeTracker::state`].
 pub const TRACKER_STATE: usize = 8;
 
-#[derive(Clone, Debug, PartialEq)]
+/// What an update takes from the interval's length alone: computed for the first interval of a
+/// length and kept while the host's step stays the same (three exponentials per step otherwise,
+/// most of the tracker's cost). The same expressions as computed afresh: the same bits.
+#[derive(Clone, Copy, Debug)]
+struct Coefficients {
+    /// The interval length they are for (NaN: none yet).
+    h: f64,
+    /// The filters' gain 1 - e^(-h/tau).
+    alpha: f64,
+    /// The velocity rebuild's decay e^(-w_c h) and e^(-w_c h) - 1.
+    decay: f64,
+    decay_m1: f64,
+}
+
+impl Coefficients {
+    const NONE: Coefficients = Coefficients {
+        h: f64::NAN,
+        alpha: 0.0,
+        decay: 0.0,
+        decay_m1: 0.0,
+    };
+}
+
+#[derive(Clone, Debug)]
 pub struct AmplitudeTracker {
     tau: f64,
     leak: f64,
@@ -35,6 +58,27 @@ pub struct AmplitudeTracker {
     ms_v: MeanSquare,
     ms_a: MeanSquare,
     weight: MeanSquare,
+    /// Derived from `h`, `tau` and `leak`: not part of what the tracker is.
+    coefficients: Coefficients,
+}
+
+/// Equal trackers: the same settings and state (whatever interval length they last saw).
+impl PartialEq for AmplitudeTracker {
+    fn eq(&self, other: &Self) -> bool {
+        (
+            self.tau,
+            self.leak,
+            self.prior,
+            self.rebuilt_v,
+            self.measured_v_seen,
+        ) == (
+            other.tau,
+            other.leak,
+            other.prior,
+            other.rebuilt_v,
+            other.measured_v_seen,
+        ) && (self.ms_v, self.ms_a, self.weight) == (other.ms_v, other.ms_a, other.weight)
+    }
 }
 
 impl AmplitudeTracker {
@@ -50,12 +94,27 @@ impl AmplitudeTracker {
             ms_v: MeanSquare::default(),
             ms_a: MeanSquare::default(),
             weight: MeanSquare::default(),
+            coefficients: Coefficients::NONE,
         }
     }
 
     /// Take in the base acceleration and velocity held over an interval of length `h`.
+    #[inline]
     pub fn update(&mut self, h: f64, accel: f64, velocity: f64) {
-        let alpha = -(-h / self.tau).exp_m1();
+        if self.coefficients.h != h {
+            self.coefficients = Coefficients {
+                h,
+                alpha: -(-h / self.tau).exp_m1(),
+                decay: (-self.leak * h).exp(),
+                decay_m1: (-self.leak * h).exp_m1(),
+            };
+        }
+        let Coefficients {
+            alpha,
+            decay,
+            decay_m1,
+            ..
+        } = self.coefficients;
         if velocity != 0.0 && !self.measured_v_seen {
             // The host drives base.v: restart the velocity statistics from the measured signal.
             self.measured_v_seen = true;
@@ -72,8 +131,7 @@ impl AmplitudeTracker {
         self.ms_a.update(alpha, accel * accel);
         self.weight.update(alpha, 1.0);
         // Exact advance of v' = a - w_c v with a held.
-        let decay = (-self.leak * h).exp();
-        self.rebuilt_v = self.rebuilt_v * decay - accel * (-self.leak * h).exp_m1() / self.leak;
+        self.rebuilt_v = self.rebuilt_v * decay - accel * decay_m1 / self.leak;
     }
 
     /// The evolving part of the estimator, for saving the state.

@@ -45,6 +45,12 @@ pub fn boundary_layer_zeta(omega_1: f64, depth: f64, breadth: f64, nu: f64, s: f
 }
 
 impl DampingLaw {
+    /// Whether [`DampingLaw::zeta`] depends on the amplitude (only then must a tracked
+    /// amplitude be known before each step).
+    pub fn reads_amplitude(&self) -> bool {
+        matches!(self, DampingLaw::Nsd { .. })
+    }
+
     /// Damping ratio for the excitation amplitude `a_e` in a tank of length `length`.
     pub fn zeta(&self, a_e: f64, length: f64, range: LambdaRange) -> f64 {
         match *self {
@@ -89,6 +95,7 @@ mod tests {
         assert_eq!(law.zeta(10.0, 0.25, RANGE), 0.5 * 0.1f64.powf(0.35));
         assert_eq!(law.zeta(f64::NAN, 0.25, RANGE), law.zeta(0.0, 0.25, RANGE));
         assert_eq!(DampingLaw::Constant(0.02).zeta(1.0, 0.25, RANGE), 0.02);
+        assert!(law.reads_amplitude() && !DampingLaw::Constant(0.02).reads_amplitude());
     }
 
     /// MODEL.md section 8's check value: the lab tank with water (nu = 1e-6 m^2/s, S = 1).
@@ -99,6 +106,7 @@ mod tests {
         assert!((z - 0.0151).abs() < 5e-5, "{z}");
         let law = DampingLaw::BoundaryLayer(z);
         assert_eq!(law.zeta(0.0, 0.25, RANGE), law.zeta(1.0, 0.25, RANGE));
+        assert!(!law.reads_amplitude());
     }
 
     #[test]

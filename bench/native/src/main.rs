@@ -4,7 +4,8 @@
 //! line; settings lines configure, `run` lines execute:
 //!
 //! ```text
-//! lib PATH                    the FMU's binaries/linux64/TLD.so
+//! lib PATH                    the FMU's binaries/linux64/TLD.so (another `lib` line: the
+//!                             `fmu` runs after it drive that library, e.g. bench/c's C FMU)
 //! guid GUID
 //! vrs base_a=50 x=63 v=64 force=60 mass_inactive=43
 //! input PATH N                N f64 (little endian): base.a held over step k (open-loop scenes)
@@ -20,6 +21,12 @@
 //! clock wall|cpu              what the runs below time: the wall clock (default) or the
 //!                             CPU time of the host's thread (not stretched by other
 //!                             processes on a loaded machine)
+//! latency on|off              open-loop runs below also time every step on its own (by the
+//!                             `clock`: the wall clock, std::time::Instant, whose own cost, some
+//!                             20-40 ns, is in every figure; or the thread's CPU time, a system
+//!                             call of some 100s of ns, which preemption does not stretch) and print
+//!                             `latency ID median_ns p99_ns p9999_ns max_ns` over the steps of
+//!                             all repeats
 //! ```
 //!
 //! Each run is repeated R times on a fresh instance; only the stepping loop is timed
@@ -143,6 +150,49 @@ struct Coupled {
     sub: u32,
     n: usize,
     m0: f64,
+}
+
+/// Open-loop scene with every step timed on its own by `clock`: the loop of [`run_open`]
+/// with a clock read between steps, the step times (ns) in `per_step`.
+fn run_open_per_step<D: Damper>(
+    d: &mut D,
+    a: &[f64],
+    dt: f64,
+    clock: Clock,
+    per_step: &mut Vec<u32>,
+) -> RunResult {
+    let n = a.len();
+    let mut xs = vec![0.0; n + 1];
+    let o = d.outputs().map_err(|e| (0, e))?;
+    xs[0] = o[0];
+    per_step.reserve(n);
+    let t0 = Stopwatch::start(clock);
+    let mut last = t0.ns();
+    for k in 0..n {
+        let o = d.step(k as f64 * dt, dt, a[k]).map_err(|e| (k, e))?;
+        xs[k + 1] = o[0];
+        let now = t0.ns();
+        per_step.push(u32::try_from(now.saturating_sub(last)).unwrap_or(u32::MAX));
+        last = now;
+    }
+    Ok(Run {
+        ns: t0.ns(),
+        x: xs,
+        big_x: vec![],
+        force: vec![],
+    })
+}
+
+/// (median, 99th, 99.99th percentile, max) of the step times, nearest rank.
+fn tails(times: &mut [u32]) -> [u32; 4] {
+    times.sort_unstable();
+    let n = times.len();
+    if n == 0 {
+        return [0; 4];
+    }
+    // the ceil(n q)-th smallest, q = num / den in integers (0.9999 n is no integer in f64)
+    let rank = |num: usize, den: usize| times[(n * num).div_ceil(den).clamp(1, n) - 1];
+    [rank(1, 2), rank(99, 100), rank(9999, 10_000), times[n - 1]]
 }
 
 /// Open-loop scene: base.a[k] held over step k. Returns (elapsed ns, x history, force history).
@@ -289,6 +339,7 @@ struct Settings {
     outdir: String,
     model: Option<Model>,
     clock: Clock,
+    latency: bool,
 }
 
 enum Kind {
@@ -297,8 +348,9 @@ enum Kind {
     Dp45(f64),
 }
 
-/// One repeat of a run: fresh damper, timed loop.
-fn once(st: &Settings, kind: &Kind) -> RunResult {
+/// One repeat of a run: fresh damper, timed loop (each step's time added to `per_step` when
+/// the settings ask for it, open-loop FMU runs only).
+fn once(st: &Settings, kind: &Kind, per_step: &mut Vec<u32>) -> RunResult {
     let e0 = |e: String| (0usize, e);
     match kind {
         Kind::Fmu(params) => {
@@ -309,6 +361,9 @@ fn once(st: &Settings, kind: &Kind) -> RunResult {
                 Some(c) => {
                     let m0 = inst.mass_inactive().map_err(e0)?;
                     run_coupled(&mut inst, c, m0, st.dt, st.clock)
+                }
+                None if st.latency => {
+                    run_open_per_step(&mut inst, &st.input, st.dt, st.clock, per_step)
                 }
                 None => run_open(&mut inst, &st.input, st.dt, st.clock),
             }
@@ -369,7 +424,11 @@ fn real_main(jobfile: &str) -> Result<(), String> {
         }
         let err = |e: String| format!("{jobfile}:{}: {e}", lineno + 1);
         match tok[0] {
-            "lib" => st.lib_path = tok[1].to_string(),
+            "lib" => {
+                // the runs below load this library (a job may time several FMUs in turn)
+                st.lib_path = tok[1].to_string();
+                st.lib = None;
+            }
             "guid" => st.guid = tok[1].to_string(),
             "vrs" => {
                 let m = kv(&tok[1..]);
@@ -409,6 +468,13 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                     Some("wall") => Clock::Wall,
                     Some("cpu") => Clock::Cpu,
                     other => return Err(err(format!("clock {other:?}: wall or cpu"))),
+                }
+            }
+            "latency" => {
+                st.latency = match tok.get(1).copied() {
+                    Some("on") => true,
+                    Some("off") => false,
+                    other => return Err(err(format!("latency {other:?}: on or off"))),
                 }
             }
             "model" => {
@@ -461,8 +527,9 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                 let mut times = Vec::new();
                 let mut first: Option<Run> = None;
                 let mut failure = None;
+                let mut per_step = Vec::new();
                 for _ in 0..st.repeats.max(1) {
-                    match once(&st, &kind) {
+                    match once(&st, &kind, &mut per_step) {
                         Ok(run) => {
                             times.push(run.ns);
                             if first.is_none() {
@@ -494,6 +561,10 @@ fn real_main(jobfile: &str) -> Result<(), String> {
                         if !force.is_empty() {
                             write_f64(&format!("{}/{id}.f.f64", st.outdir), &force).map_err(err)?;
                         }
+                        if !per_step.is_empty() {
+                            let [median, p99, p9999, max] = tails(&mut per_step);
+                            writeln!(out, "latency {id} {median} {p99} {p9999} {max}").ok();
+                        }
                         let all: Vec<String> = times.iter().map(|t| t.to_string()).collect();
                         let med = median(&mut times.clone());
                         writeln!(
@@ -511,4 +582,19 @@ fn real_main(jobfile: &str) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// Nearest rank: of 1..=10,000 ns the median is 5,000, the 99th percentile 9,900, the
+    /// 99.99th 9,999 (not the worst), the worst 10,000; of 3 steps the median is the 2nd (the
+    /// rank rounds up); whatever the order they came in.
+    #[test]
+    fn tails_are_nearest_ranks() {
+        let mut times: Vec<u32> = (1..=10_000).rev().collect();
+        assert_eq!(super::tails(&mut times), [5_000, 9_900, 9_999, 10_000]);
+        assert_eq!(super::tails(&mut [3, 1, 2]), [2, 3, 3, 3]);
+        assert_eq!(super::tails(&mut [7]), [7; 4]);
+        assert_eq!(super::tails(&mut []), [0; 4]);
+    }
 }

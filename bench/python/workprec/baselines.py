@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tld_fmu.scenes import TOLS, coupled_master, n_steps, rel_err, substep_counts
+from tld_fmu.scenes import TOLS, FmpyDamper, coupled_master, n_steps, rel_err, substep_counts
 
 HERE = Path(__file__).resolve().parent.parent   # bench/python, where tld_py.py is
 PY_REPEATS = 3          # Python baselines: median of this many runs over the window
@@ -50,25 +50,6 @@ class ScipyDamper:
             raise RuntimeError(sol.message)
         self.y = [float(sol.y[0, -1]), float(sol.y[1, -1])]
         return self.outputs()
-
-
-class FmpyDamper:
-    """An FMU through fmpy's FMU2Slave (tld_fmu.slave.Slave): set base.a, doStep, get outputs."""
-
-    def __init__(self, slave, a_name, out_names):
-        self.s = slave
-        f = slave.fmu
-        self.vr_a = [slave.vr(a_name)]
-        self.vr_out = [slave.vr(n) for n in out_names]
-        self.f = f
-
-    def outputs(self):
-        return tuple(self.f.getReal(self.vr_out))
-
-    def step(self, t, dt, ab):
-        self.f.setReal(self.vr_a, [ab])
-        self.f.doStep(t, dt)
-        return tuple(self.f.getReal(self.vr_out))
 
 
 def open_loop(damper, a, dt, n):
@@ -172,7 +153,7 @@ def run_python(fi, sc, dt, a, refs, quick, tld_slave, py_slave):
     def tld(sc=sc):
         s = tld_slave()
         try:
-            s.initialize(fi.physics_params(sc.p) if sc.fmu_physics else {})
+            s.initialize(fi.scene_params(sc))
             if sc.kind == "coupled":
                 d = FmpyDamper(s, "base.a", ["slosh.x", "slosh.v", "force"])
                 d.m0 = s.get("mass.inactive")

@@ -12,6 +12,8 @@ import numpy as np
 from tld_fmu.scenes import (TOLS, NATIVE_BIN, FmuInfo, Scene, n_steps, rel_err,
                             substep_counts)
 
+from .cfmu import c_fmu, c_tokens
+
 
 def run_native(fi: FmuInfo, sc: Scene, dt, a, refs, quick, tmp: Path):
     n = n_steps(sc, dt)
@@ -34,7 +36,7 @@ def run_native(fi: FmuInfo, sc: Scene, dt, a, refs, quick, tmp: Path):
         f = outdir / "input.f64"
         a.astype("<f8").tofile(f)
         lines.append(f"input {f} {n}")
-    phys = fi.physics_tokens(p) if sc.fmu_physics else []
+    phys = fi.scene_tokens(sc)
     meta = {}
     for method, setting, toks in fi.solver_settings(dt, quick, p.omega_f):
         rid = f"fmu_{method}_{setting}".replace("=", "").replace("+", "")
@@ -53,6 +55,20 @@ def run_native(fi: FmuInfo, sc: Scene, dt, a, refs, quick, tmp: Path):
     rid = f"rust_RK4abs_{ns}"
     meta[rid] = dict(impl="Rust diagnostic", method="RK4 over (t+dt)-t", setting=f"n={ns}")
     lines.append(f"run {rid} rk4 sub={ns} span=abs")
+    # the careful C FMU (bench/c/tld_c.c) through the same host and calls: RK4 with the same
+    # substeps as TLD.fmu's, DormandPrince45 at the same tolerances
+    lines.append(f"lib {c_fmu(tmp)}")
+    ctoks = c_tokens(fi, p)
+    for ns in substep_counts(dt, quick):
+        rid = f"c_RK4_{ns}"
+        meta[rid] = dict(impl="C FMU", method="RK4", setting=f"n={ns}")
+        lines.append(f"run {rid} fmu {' '.join(ctoks)} {fi.token('solver', 'RK4')} "
+                     f"{fi.token('solver.fixed_step', dt / ns)}")
+    for tol in (TOLS if not quick else [1e-6, 1e-10]):
+        rid = f"c_DP45_{tol:g}"
+        meta[rid] = dict(impl="C FMU", method="DP45", setting=f"tol={tol:g}")
+        lines.append(f"run {rid} fmu {' '.join(ctoks)} {fi.token('solver', 'DormandPrince45')} "
+                     f"{fi.token('solver.tolerance', tol)}")
     job = outdir / "jobs.txt"
     job.write_text("\n".join(lines) + "\n")
     proc = subprocess.run([str(NATIVE_BIN), str(job)], capture_output=True, text=True)

@@ -17,6 +17,8 @@ def plots(scenes, rows, outdir: Path, tag):
         ("TLD.fmu", "RK4"): dict(color="C1", marker="s"),
         ("TLD.fmu", "RK5"): dict(color="darkgoldenrod", marker="p"),
         ("TLD.fmu", "RK8"): dict(color="teal", marker="h"),
+        ("C FMU", "DP45"): dict(color="navy", marker="o", ls=":", mfc="none", ms=9),
+        ("C FMU", "RK4"): dict(color="saddlebrown", marker="s", ls=":", mfc="none", ms=9),
         ("Rust baseline", "DP45"): dict(color="C0", marker="o", ls="--", mfc="none"),
         ("Rust baseline", "RK4"): dict(color="C1", marker="s", ls="--", mfc="none"),
         ("scipy solve_ivp", "DOP853"): dict(color="C2", marker="^"),

@@ -346,6 +346,72 @@ fn tracked_amplitude_settles_within_five_percent() {
     }
 }
 
+/// Under a damping law that ignores the amplitude, the tracker only takes in each step's input
+/// and its estimate is formed when read. Read late (only at the end, after 3000 steps with the
+/// communication step changing and the host starting to drive base.v halfway), A_e.estimate and
+/// the saved tracker state are those of a reference tracker that computes everything afresh
+/// every step (a new tracker from the saved state, so no coefficient kept from one step to the
+/// next), bit for bit, and those of the same run under the NSD law, which reads the estimate
+/// every step; a restored damper continues the same. Guards the lazy path against drifting from
+/// the eager one (a stale coefficient, a skipped update, an update on a refused step).
+#[test]
+fn tracked_amplitude_read_late_is_exact() {
+    let lazy_p = tracked(defaults())
+        .with(vr::DAMPING, CONSTANT)
+        .with(vr::ZETA, 0.02);
+    let eager_p = tracked(defaults());
+    let (mut lazy, mut eager) = (damper(&lazy_p), damper(&eager_p));
+    assert!(!lazy.damping_reads_amplitude && eager.damping_reads_amplitude);
+    let wf = lazy.derived().omega_f;
+    let (tau, prior) = (2.0 * std::f64::consts::TAU / wf, 0.005);
+    let mut reference = AmplitudeTracker::new(tau, 0.05 * wf, prior);
+    let mut t = 0.0;
+    for k in 0..3000 {
+        let h = [0.01, 0.004, 0.01, 0.0125][(k / 400) % 4];
+        let w = 1.05 * wf;
+        let inputs = Inputs {
+            a: -w * w * 0.003 * (w * t).sin(),
+            v: if k >= 1500 {
+                w * 0.003 * (w * t).cos()
+            } else {
+                0.0
+            },
+            ..Inputs::default()
+        };
+        lazy.step(t, h, &inputs).expect("step");
+        eager.step(t, h, &inputs).expect("step");
+        let mut fresh = AmplitudeTracker::new(tau, 0.05 * wf, prior);
+        fresh.set_state(&reference.state()).expect("a saved state");
+        fresh.update(h, inputs.a, inputs.v);
+        reference = fresh;
+        t += h;
+    }
+    let late = lazy.output(Output::Amplitude, &held(0.0));
+    assert_eq!(late.to_bits(), reference.estimate().to_bits());
+    assert_eq!(late, eager.output(Output::Amplitude, &held(0.0)));
+    assert!(
+        (late / 0.003 - 1.0).abs() < 0.05,
+        "the estimate follows: {late}"
+    );
+    // The saved frame: the amplitude, then the tracker's state, as the eager run saves them.
+    let (saved, saved_eager) = (lazy.snapshot(), eager.snapshot());
+    let frame = |s: &[f64]| s[s.len() - FRAME..].to_vec();
+    assert_eq!(frame(&saved)[0].to_bits(), late.to_bits());
+    assert_eq!(frame(&saved)[3..], reference.state());
+    assert_eq!(frame(&saved)[3..], frame(&saved_eager)[3..]);
+    // A refused step takes nothing in.
+    assert!(lazy.step(t, 0.1, &held(-1e300)).is_err());
+    assert_eq!(lazy.snapshot(), saved);
+    let mut restored = Damper::restore(&lazy_p, &saved).expect("restore");
+    assert_eq!(restored.output(Output::Amplitude, &held(0.0)), late);
+    restored.step(t, 0.01, &held(0.2)).expect("step");
+    reference.update(0.01, 0.2, 0.0);
+    assert_eq!(
+        restored.output(Output::Amplitude, &held(0.0)),
+        reference.estimate()
+    );
+}
+
 #[test]
 fn inconsistent_configurations_are_refused() {
     let bad = defaults()
