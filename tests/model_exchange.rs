@@ -225,3 +225,33 @@ fn model_exchange_instances_in_threads_match_serial_runs() {
         x.iter().fold(0u64, |h, v| h.rotate_left(7) ^ v.to_bits())
     });
 }
+
+/// With logging on, fmi2Instantiate for Model Exchange says what ME offers and what not.
+#[test]
+fn instantiating_for_model_exchange_says_what_is_offered() {
+    let lib = library();
+    let callbacks = callbacks();
+    let name = std::ffi::CString::new("me-note").expect("name");
+    let guid = std::ffi::CString::new(GUID).expect("guid");
+    // SAFETY: valid strings and callbacks that outlive the instance, freed below.
+    let c = unsafe {
+        lib.fmi2Instantiate(
+            name.as_ptr(),
+            fmi_sys::fmi2::fmi2Type_fmi2ModelExchange,
+            guid.as_ptr(),
+            std::ptr::null(),
+            &*callbacks,
+            0,
+            1,
+        )
+    };
+    assert!(!c.is_null());
+    unsafe { lib.fmi2FreeInstance(c) };
+    let said = logs_of("me-note").join("\n");
+    for part in [
+        "Linear (modes = 1)",
+        "SloshingSlamming, ShallowWater and amplitude = Tracked",
+    ] {
+        assert!(said.contains(part), "no '{part}' in: {said}");
+    }
+}

@@ -78,6 +78,19 @@ pub fn library() -> &'static Fmi2Binding {
     })
 }
 
+/// Messages the FMU logged so far for the instance named `name`.
+pub fn logs_of(name: &str) -> Vec<String> {
+    RECORDS
+        .lock()
+        .map(|r| {
+            r.iter()
+                .filter(|(n, _, _)| n == name)
+                .map(|(_, _, m)| m.clone())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
 pub fn callbacks() -> Box<fmi2CallbackFunctions> {
     Box::new(fmi2CallbackFunctions {
         logger: Some(logger::callback_logger_handler),
@@ -136,15 +149,7 @@ impl Instance {
 
     /// Messages the FMU logged for this instance so far.
     pub fn logs(&self) -> Vec<String> {
-        RECORDS
-            .lock()
-            .map(|r| {
-                r.iter()
-                    .filter(|(n, _, _)| *n == self.name)
-                    .map(|(_, _, m)| m.clone())
-                    .collect()
-            })
-            .unwrap_or_default()
+        logs_of(&self.name)
     }
 
     pub fn setup(&self) -> fmi2Status {
