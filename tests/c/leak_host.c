@@ -9,6 +9,10 @@
  * checked; -DVR_EXTRA=vr -DEXTRA_VALUE=v sets one more Integer parameter in every cycle (TLD.fmu:
  * 16 shallow-water cells, enough to allocate everything and cheap under valgrind). Afterwards it
  * measures the heap one initialised instance holds, from 1000 live instances at once.
+ * With -DNX=n (the model description's continuous states), cycles also run a Model
+ * Exchange instance of the same configuration (every configuration, one round in 50) (-DVR_AMPLITUDE=vr: amplitude = Fixed): the event
+ * iteration, continuous-time mode, states and derivatives, a refused non-finite state, a saved
+ * and restored state; a configuration ME does not offer is refused at exit (fmi2Error) and freed.
  * Exit status 0 = all calls returned the expected status. */
 #include <dlfcn.h>
 #include <malloc.h>
@@ -77,6 +81,31 @@ int main(int argc, char **argv) {
     LOAD(fmi2FreeFMUstate) LOAD(fmi2SerializedFMUstateSize) LOAD(fmi2SerializeFMUstate)
     LOAD(fmi2DeSerializeFMUstate) LOAD(fmi2SetInteger)
     (void)fmi2SetInteger;
+#ifdef NX
+    typedef int (*fmi2SetTime_t)(comp_t, double);
+    typedef int (*fmi2States_t)(comp_t, double *, size_t);
+    typedef int (*fmi2SetContinuousStates_t)(comp_t, const double *, size_t);
+    typedef int (*fmi2Mode_t)(comp_t);
+    typedef int (*fmi2CompletedIntegratorStep_t)(comp_t, int, int *, int *);
+    typedef struct { int needed, terminate, nominals, values, next_defined; double next; } info_t;
+    typedef int (*fmi2NewDiscreteStates_t)(comp_t, info_t *);
+    fmi2SetTime_t fmi2SetTime = (fmi2SetTime_t)dlsym(lib, "fmi2SetTime");
+    fmi2States_t fmi2GetContinuousStates = (fmi2States_t)dlsym(lib, "fmi2GetContinuousStates");
+    fmi2States_t fmi2GetDerivatives = (fmi2States_t)dlsym(lib, "fmi2GetDerivatives");
+    fmi2SetContinuousStates_t fmi2SetContinuousStates =
+        (fmi2SetContinuousStates_t)dlsym(lib, "fmi2SetContinuousStates");
+    fmi2Mode_t fmi2EnterContinuousTimeMode = (fmi2Mode_t)dlsym(lib, "fmi2EnterContinuousTimeMode");
+    fmi2CompletedIntegratorStep_t fmi2CompletedIntegratorStep =
+        (fmi2CompletedIntegratorStep_t)dlsym(lib, "fmi2CompletedIntegratorStep");
+    fmi2NewDiscreteStates_t fmi2NewDiscreteStates =
+        (fmi2NewDiscreteStates_t)dlsym(lib, "fmi2NewDiscreteStates");
+    if (!fmi2SetTime || !fmi2GetContinuousStates || !fmi2GetDerivatives || !fmi2SetContinuousStates
+        || !fmi2EnterContinuousTimeMode || !fmi2CompletedIntegratorStep || !fmi2NewDiscreteStates) {
+        fprintf(stderr, "missing a Model Exchange function\n");
+        return 2;
+    }
+    unsigned long me_runs = 0;
+#endif
     callbacks_t cb = { logger, NULL, NULL, NULL, NULL };
     /* Value references from modelDescription.xml, passed in by scripts/leakcheck. */
     const unsigned base_a = VR_BASE_A, slosh_x = VR_SLOSH_X, eta = VR_ETA, unknown = 9999;
@@ -131,8 +160,66 @@ int main(int argc, char **argv) {
         CHECK(fmi2GetReal(c, &slosh_x, 1, &x), 0);
         CHECK(fmi2Terminate(c), 0);
         fmi2FreeInstance(c);
+#ifdef NX
+        /* Every configuration in turn, one round in 50 (valgrind makes an ME run of 20 steps
+         * of the 44-state building cost about 0.1 s). */
+#if defined(VR_CYCLE) && defined(CYCLE_N)
+        const int me_round = (cycle / CYCLE_N) % 50 == 0;
+#else
+        const int me_round = cycle % 50 == 0;
+#endif
+        if (!me_round) continue;
+        comp_t m = fmi2Instantiate("leak-me", 0, guid, NULL, &cb, 0, 0);
+        if (!m) { fprintf(stderr, "instantiate (Model Exchange) failed\n"); return 1; }
+        CHECK(fmi2SetupExperiment(m, 0, 0.0, 0.0, 0, 0.0), 0);
+        CHECK(fmi2EnterInitializationMode(m), 0);
+#if defined(VR_CYCLE) && defined(CYCLE_N)
+        CHECK(fmi2SetInteger(m, &selector, 1, &choice), 0);
+#endif
+#if defined(VR_EXTRA) && defined(EXTRA_VALUE)
+        CHECK(fmi2SetInteger(m, &extra, 1, &extra_value), 0);
+#endif
+#ifdef VR_AMPLITUDE
+        const unsigned amplitude = VR_AMPLITUDE;
+        const int fixed = 1;
+        CHECK(fmi2SetInteger(m, &amplitude, 1, &fixed), 0);
+#endif
+        if (fmi2ExitInitializationMode(m) == 0) {
+            info_t info;
+            double xs[NX], dx[NX], tm = 0.0;
+            CHECK(fmi2NewDiscreteStates(m, &info), 0);
+            CHECK(fmi2EnterContinuousTimeMode(m), 0);
+            CHECK(fmi2GetContinuousStates(m, xs, NX), 0);
+            void *saved = NULL;
+            for (int k = 0; k < 20; k++) {
+                double a = -36.0 * 0.004 * sin(6.0 * tm);
+                CHECK(fmi2SetReal(m, &base_a, 1, &a), 0);
+                CHECK(fmi2GetDerivatives(m, dx, NX), 0);
+                for (int i = 0; i < NX; i++) xs[i] += 0.01 * dx[i];
+                tm += 0.01;
+                CHECK(fmi2SetTime(m, tm), 0);
+                CHECK(fmi2SetContinuousStates(m, xs, NX), 0);
+                int enter = 0, stop = 0;
+                CHECK(fmi2CompletedIntegratorStep(m, 1, &enter, &stop), 0);
+                if (k == 10) CHECK(fmi2GetFMUstate(m, &saved), 0);
+            }
+            double bad_states[NX];
+            memcpy(bad_states, xs, sizeof xs);
+            bad_states[0] = NAN;
+            CHECK(fmi2SetContinuousStates(m, bad_states, NX), 3);
+            CHECK(fmi2SetFMUstate(m, saved), 0);
+            CHECK(fmi2FreeFMUstate(m, &saved), 0);
+            CHECK(fmi2Terminate(m), 0);
+            me_runs++;
+        }
+        fmi2FreeInstance(m);
+#endif
     }
     printf("leak_host: %d cycles, %lu log messages, last slosh.x %.6e\n", cycles, messages, x);
+#ifdef NX
+    printf("leak_host: %lu of them ran Model Exchange (%d states)\n", me_runs, NX);
+    if (cycles > 0 && me_runs == 0) { fprintf(stderr, "no cycle ran Model Exchange\n"); return 1; }
+#endif
 
     /* Heap held by one initialised instance: 1000 of them alive at once. */
     enum { LIVE = 1000 };
