@@ -11,7 +11,8 @@
 /// The platform folders the tool packs, with the binary each must hold.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Platform {
-    /// x86_64 Linux (FMI 2.0's linux64)
+    /// 64-bit Linux (FMI 2.0's linux64): x86_64, or aarch64 in an FMU for aarch64 hosts, which
+    /// look for FMI 2.0 binaries in linux64 too (fmpy, FMIL: docs/PLATFORMS.md)
     Linux64,
     /// aarch64 Linux (FMI 3.0's name; FMI 2.0 names no folder for it)
     Aarch64Linux,
@@ -70,7 +71,7 @@ pub struct Binary {
 pub fn check(bytes: &[u8], platform: Platform, what: &str) -> Result<Binary, String> {
     let bin = read(bytes).map_err(|e| format!("{what}: {e}"))?;
     let (format, machines): (&str, &[&str]) = match platform {
-        Platform::Linux64 => ("ELF", &["x86_64"]),
+        Platform::Linux64 => ("ELF", &["x86_64", "aarch64"]),
         Platform::Aarch64Linux => ("ELF", &["aarch64"]),
         Platform::Win64 => ("PE", &["x86_64"]),
         Platform::Darwin64 => ("Mach-O", &["x86_64", "aarch64"]),
@@ -441,7 +442,10 @@ pub mod tests {
         assert!(e.contains("another machine"), "{e}");
         let good = macho_file(0x0100_0007, 6, &refs(&names));
         let e = check(&good, Platform::Linux64, "lib").unwrap_err();
-        assert!(e.contains("binaries/linux64 needs ELF for x86_64"), "{e}");
+        assert!(
+            e.contains("binaries/linux64 needs ELF for x86_64 or aarch64"),
+            "{e}"
+        );
         // slices that differ
         let fat = universal_file(&[
             (0x0100_0007, good.clone()),
