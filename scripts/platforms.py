@@ -22,6 +22,7 @@ import tempfile
 import time
 import xml.etree.ElementTree as ET
 import zipfile
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from tqdm import tqdm
@@ -111,8 +112,8 @@ def ulps(a, b):
 # glibc's: win64 takes them from msvcrt.dll and MinGW-w64's libm, whose last bits differ; the
 # model's chaotic runs (impacts, the shallow-water solver) then grow those differences. Their
 # outputs must stay within LIBM_TOLERANCE of each output's range over the run (the worst seen:
-# 1.3e-14, docs/PLATFORMS.md); linux64 and
-# aarch64-linux, both on glibc's libm, must agree bit for bit.
+# 1.3e-14, docs/PLATFORMS.md); linux64 and aarch64-linux, both on glibc's libm, must agree bit
+# for bit.
 LIBM_DIFFERS = {"win64"}
 LIBM_TOLERANCE = 1e-10
 
@@ -161,24 +162,28 @@ def main():
     failures, rows, state_runs = [], [], 0
     t0 = time.monotonic()
     save_at = args.steps // 2
+    pool = ThreadPoolExecutor(max_workers=len(PLATFORMS))
     for label, fmu_id, text, outputs in tqdm(all_scenes, desc="scenes", unit="scene"):
         scene = work / (label.replace(" ", "_") + ".scene")
         scene.write_text(text)
-        full, states = {}, {}
+        # the runs are independent processes, mostly waiting on the emulators' start-up:
+        # run side by side
+        full = dict(zip(PLATFORMS, pool.map(
+            lambda p: run(p, libs[p, fmu_id], scene,
+                          ["--save", save_at, work / f"{scene.stem}.{p}.state"]), PLATFORMS)))
+        states = {p: (work / f"{scene.stem}.{p}.state").read_bytes() for p in PLATFORMS}
         for p in PLATFORMS:
-            state = work / f"{scene.stem}.{p}.state"
-            full[p] = run(p, libs[p, fmu_id], scene, ["--save", save_at, state])
-            states[p] = state.read_bytes()
             if len(full[p]) != args.steps:
                 failures.append(f"{label}: {p} printed {len(full[p])} steps, not {args.steps}")
         # the state saved by each platform, restored and continued on every platform; on its
         # own platform the continuation must be the uninterrupted run's, bit for bit
-        cont = {}
+        transfers = [(saved, p) for saved in PLATFORMS for p in PLATFORMS]
+        cont = dict(zip(transfers, pool.map(
+            lambda sp: run(sp[1], libs[sp[1], fmu_id], scene,
+                           ["--restore", save_at, work / f"{scene.stem}.{sp[0]}.state"]),
+            transfers)))
+        state_runs += len(transfers)
         for saved in PLATFORMS:
-            for p in PLATFORMS:
-                state = work / f"{scene.stem}.{saved}.state"
-                cont[saved, p] = run(p, libs[p, fmu_id], scene, ["--restore", save_at, state])
-                state_runs += 1
             if cont[saved, saved] != full[saved][save_at:]:
                 failures.append(f"{label}: state restored on {saved} departs from its own run")
         cells = []
