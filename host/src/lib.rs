@@ -420,6 +420,71 @@ impl Instance {
     }
 }
 
+/// The instance's state through fmi2GetFMUstate and fmi2SerializeFMUstate, and back through
+/// fmi2DeSerializeFMUstate and fmi2SetFMUstate: a state serialised by one binary of the FMU (one
+/// platform) can be restored by another.
+impl Instance {
+    /// The state now, serialised (fmi2GetFMUstate, fmi2SerializedFMUstateSize,
+    /// fmi2SerializeFMUstate; the state is freed after).
+    pub fn serialize_state(&mut self) -> Result<Vec<u8>, String> {
+        let b = &self._binding;
+        let get = resolved("fmi2GetFMUstate", &b.fmi2GetFMUstate, "the FMU")?;
+        let size_of = resolved(
+            "fmi2SerializedFMUstateSize",
+            &b.fmi2SerializedFMUstateSize,
+            "the FMU",
+        )?;
+        let serialize = resolved("fmi2SerializeFMUstate", &b.fmi2SerializeFMUstate, "the FMU")?;
+        let free = resolved("fmi2FreeFMUstate", &b.fmi2FreeFMUstate, "the FMU")?;
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        // SAFETY: a live instance of this library; out-pointers to locals; the buffer holds
+        // `size` bytes as fmi2SerializeFMUstate is told.
+        unsafe {
+            check("fmi2GetFMUstate", get(self.c, &mut state))?;
+            let mut size = 0usize;
+            let mut bytes = Vec::new();
+            let done = check(
+                "fmi2SerializedFMUstateSize",
+                size_of(self.c, state, &mut size),
+            )
+            .and_then(|()| {
+                bytes = vec![0u8; size];
+                check(
+                    "fmi2SerializeFMUstate",
+                    serialize(self.c, state, bytes.as_mut_ptr().cast(), size),
+                )
+            });
+            check("fmi2FreeFMUstate", free(self.c, &mut state))?;
+            done?;
+            Ok(bytes)
+        }
+    }
+
+    /// The instance takes the serialised state `bytes` (fmi2DeSerializeFMUstate,
+    /// fmi2SetFMUstate; the state is freed after).
+    pub fn restore_state(&mut self, bytes: &[u8]) -> Result<(), String> {
+        let b = &self._binding;
+        let deserialize = resolved(
+            "fmi2DeSerializeFMUstate",
+            &b.fmi2DeSerializeFMUstate,
+            "the FMU",
+        )?;
+        let set = resolved("fmi2SetFMUstate", &b.fmi2SetFMUstate, "the FMU")?;
+        let free = resolved("fmi2FreeFMUstate", &b.fmi2FreeFMUstate, "the FMU")?;
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        // SAFETY: a live instance of this library; `bytes` is read, its length given.
+        unsafe {
+            check(
+                "fmi2DeSerializeFMUstate",
+                deserialize(self.c, bytes.as_ptr().cast(), bytes.len(), &mut state),
+            )?;
+            let done = check("fmi2SetFMUstate", set(self.c, state));
+            check("fmi2FreeFMUstate", free(self.c, &mut state))?;
+            Ok(done?)
+        }
+    }
+}
+
 impl Drop for Instance {
     fn drop(&mut self) {
         // SAFETY: c is live until here and freed once; the binary is still loaded (_binding).

@@ -285,7 +285,8 @@ impl Fuzz {
                         .iter()
                         .map(|s| CString::new(s.as_str()).unwrap())
                         .collect();
-                    let ptrs: Vec<*const i8> = owned.iter().map(|s| s.as_ptr()).collect();
+                    let ptrs: Vec<*const std::ffi::c_char> =
+                        owned.iter().map(|s| s.as_ptr()).collect();
                     lib.fmi2SetDebugLogging(c, i32::from(*on), ptrs.len(), ptrs.as_ptr())
                 }
                 Call::SaveState => {
