@@ -18,7 +18,7 @@
 
 use std::f64::consts::PI;
 
-use crate::analysis::excitation::{Optimum, TwoDof, warburton};
+use crate::analysis::excitation::{Optimum, RANDOM_SCREENS, TwoDof, warburton};
 use crate::description::{AmplitudeModeItem, DampingLawItem, ModelKindItem, vr};
 use crate::model::{Damper, Inputs, Output, StartValues};
 use crate::physics::geometry::Tank;
@@ -305,7 +305,7 @@ fn response_measures(
         Excitation::Wind { s0 } => {
             let (sx, sd) = two.white_noise_rms(*s0)?;
             // The random Screens law: zeta_s = 1.880 K sigma (MODEL.md 11).
-            (3.0 * (PI / 8.0).sqrt() * sd, sx)
+            (RANDOM_SCREENS * sd, sx)
         }
         Excitation::Record {
             step,
@@ -609,9 +609,20 @@ mod tests {
             d.tank.fundamental().mass / d.tank.liquid_mass(),
         );
         assert!((d.zeta_bl + k * d.sloshing - d.zeta_opt).abs() < 1e-9 * d.zeta_opt);
+        // The response the screens are sized for is 1.880 times the tuned mass's rms.
         let Excitation::Wind { s0 } = e else {
             unreachable!()
         };
+        let two = TwoDof {
+            mass: s.mass,
+            omega: s.omega(),
+            zeta: s.damping,
+            mu: d.mu,
+            gamma: d.gamma,
+            zeta_d: d.zeta_opt,
+        };
+        let (sx, sd) = two.white_noise_rms(s0).expect("stable");
+        assert!((d.sloshing / sd - 1.880).abs() < 1e-3 && d.predicted == sx);
         let h = 1.0 / s.frequency / 64.0;
         let count = (1600.0 / h) as usize;
         let f = wind_force(s0, (0.3 * s.omega(), 3.0 * s.omega()), h, count, 1);

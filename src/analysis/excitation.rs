@@ -29,6 +29,11 @@
 use nalgebra::{DMatrix, DVector, Matrix4, Vector4};
 use std::f64::consts::PI;
 
+/// The random Screens law's factor (MODEL.md 11): zeta_s = K X for a sinusoid of amplitude X
+/// becomes zeta_s = 3 sqrt(pi/8) K sigma = 1.880 K sigma for Gaussian narrow-band response of
+/// standard deviation sigma (E|u|^3 / E[u^2] = 2 sqrt(2/pi) sigma against (8/(3 pi)) U).
+pub const RANDOM_SCREENS: f64 = 1.879_971_205_973_250_3;
+
 /// Which optimum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Optimum {
@@ -250,5 +255,41 @@ mod tests {
         let want = 0.8 / (2.0 * s.zeta * s.omega * s.omega);
         assert!((peak / want - 1.0).abs() < 1e-3, "{peak} vs {want}");
         assert!((s.ground_transfer(l, s.omega) / want - 1.0).abs() < 1e-9);
+    }
+
+    /// The random factor by quadrature: E|u|^3/E[u^2] for a unit Gaussian (Simpson on
+    /// [-12, 12]) over the same for a unit sinusoid (the mean of |cos|^3 over the mean of
+    /// cos^2, Simpson over a period), and its closed form 3 sqrt(pi/8).
+    #[test]
+    fn random_screens_factor_by_quadrature() {
+        let simpson = |f: &dyn Fn(f64) -> f64, a: f64, b: f64| {
+            let n = 20000;
+            let h = (b - a) / n as f64;
+            (0..=n)
+                .map(|k| {
+                    let w = if k == 0 || k == n {
+                        1.0
+                    } else if k % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    };
+                    w * f(a + h * k as f64)
+                })
+                .sum::<f64>()
+                * h
+                / 3.0
+        };
+        let pdf = |u: f64| (-0.5 * u * u).exp() / (2.0 * PI).sqrt();
+        let gauss = simpson(&|u| u.abs().powi(3) * pdf(u), -12.0, 12.0)
+            / simpson(&|u| u * u * pdf(u), -12.0, 12.0);
+        let sine = simpson(&|t: f64| t.cos().abs().powi(3), 0.0, 2.0 * PI)
+            / simpson(&|t: f64| t.cos().powi(2), 0.0, 2.0 * PI);
+        assert!(
+            (gauss / sine / RANDOM_SCREENS - 1.0).abs() < 1e-9,
+            "{}",
+            gauss / sine
+        );
+        assert!((3.0 * (PI / 8.0).sqrt() / RANDOM_SCREENS - 1.0).abs() < 1e-15);
     }
 }
