@@ -1,19 +1,20 @@
-//! Preliminary design of a TLD with damping screens for a structural mode under harmonic
-//! excitation at resonance (after Tait 2008's procedure, with Warburton's optimum), and its
-//! check by co-simulation with the shallow-water model (screens resolved).
+//! Preliminary design of a TLD with damping screens for a structural mode under a design
+//! excitation (a harmonic force at resonance, wind as a white-noise force, a ground-motion
+//! record), after Tait 2008's procedure with Warburton's optima (analysis::excitation), and its
+//! check by co-simulation with the shallow-water model (screens resolved). docs/DESIGN.md.
 //!
 //! 1. The effective mass ratio mu = m_1/M (m_1 the fundamental sloshing mass of all tanks, Eq
-//!    2.1, from the water mass ratio and the depth ratio) gives Warburton's optimum for a
-//!    harmonic force on an undamped structure: frequency ratio gamma = 1/(1 + mu), damping
-//!    zeta_opt = sqrt(3 mu / (8 (1 + mu))).
-//! 2. The design amplitude: the controlled structure's resonant response to the force,
-//!    X = (P/K) sqrt(1 + 2/mu) (Den Hartog's fixed points), is the tank's base amplitude A_e.
+//!    2.1, from the water mass ratio and the depth ratio) gives Warburton's optimum frequency
+//!    ratio gamma and damping zeta_opt for the excitation.
+//! 2. The design response: the tuned mass's response X in the Screens law zeta_s = K X, with the
+//!    optimal linear damper on the structure (harmonic: A_e/(2 zeta_opt), A_e the structure's
+//!    resonant amplitude (P/K) sqrt(1 + 2/mu); wind: 1.880 sigma of the tuned mass; record: its
+//!    peak); the equivalent base amplitude A_e = 2 zeta_opt X.
 //! 3. The tank: length from Eq 2.2 at the depth ratio for the linear frequency
 //!    gamma omega_s / kappa(Lambda), kappa the NSD hardening at Lambda = A_e/a (iterated: a
 //!    depends on the frequency, Lambda on a); shortened to the footprint by a shallower depth
 //!    ratio if needed; breadth and count from the water mass and the largest breadth.
-//! 4. The screens: the Screens law's K that makes zeta(A_e) = zeta_opt,
-//!    K = 2 zeta_opt (zeta_opt - zeta_BL)/A_e, then the loss coefficient
+//! 4. The screens: K = (zeta_opt - zeta_BL)/X, then the loss coefficient
 //!    C_l = K a / ((2/3)(m_1/M_l) sum |sin(pi x_j/a)|^3) and the solidity with that C_l.
 
 use std::f64::consts::PI;
