@@ -293,7 +293,14 @@ fn run(o: &Args) -> Result<(), String> {
         e => histories(o, &d, e, &cases)?,
     };
     let elapsed = start.elapsed();
-    report::write(o, &d, &cases, &check, designed, elapsed)
+    report::write(&report::Run {
+        o,
+        d: &d,
+        cases: &cases,
+        check: &check,
+        designed,
+        elapsed,
+    })
 }
 
 /// The harmonic check: each case swept over 0.75-1.25 of the nominal structure's frequency,

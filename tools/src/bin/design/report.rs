@@ -15,14 +15,18 @@ fn bare(s: &Structure, ratio: f64) -> f64 {
         / ((1.0 - ratio * ratio).powi(2) + (2.0 * s.damping * ratio).powi(2)).sqrt()
 }
 
-pub fn write(
-    o: &Args,
-    d: &Designed,
-    cases: &[Case],
-    check: &Check,
-    designed: Duration,
-    elapsed: Duration,
-) -> Result<(), String> {
+/// A finished run: the options, the design, the check and the times.
+pub struct Run<'a> {
+    pub o: &'a Args,
+    pub d: &'a Designed,
+    pub cases: &'a [Case],
+    pub check: &'a Check,
+    pub designed: Duration,
+    pub elapsed: Duration,
+}
+
+pub fn write(r: &Run) -> Result<(), String> {
+    let (o, d, cases, check) = (r.o, r.d, r.cases, r.check);
     std::fs::create_dir_all(&o.out).map_err(|e| format!("{}: {e}", o.out))?;
     let write = |name: &str, text: String| {
         let path = format!("{}/{name}", o.out);
@@ -34,7 +38,7 @@ pub fn write(
     };
     write("response.csv", csv)?;
     write("response.svg", svg)?;
-    let text = report(o, d, cases, check, designed, elapsed);
+    let text = report(r);
     write("report.md", text.clone())?;
     print!("{text}");
     Ok(())
@@ -191,14 +195,9 @@ fn excitation_text(o: &Args, d: &Designed) -> String {
     }
 }
 
-fn report(
-    o: &Args,
-    d: &Designed,
-    cases: &[Case],
-    check: &Check,
-    designed: Duration,
-    elapsed: Duration,
-) -> String {
+fn report(r: &Run) -> String {
+    let (o, d, cases, check, designed, elapsed) =
+        (r.o, r.d, r.cases, r.check, r.designed, r.elapsed);
     let (s, g) = (&d.s, &d.design);
     let t = &g.tank;
     let mut out = String::new();
@@ -339,17 +338,17 @@ fn report(
                 out,
                 "| case | rms [m] with / bare | ratio | peak [m] with / bare | ratio |\n|---|---|---|---|---|"
             );
-            for (c, r) in cases.iter().zip(rows) {
+            for (c, row) in cases.iter().zip(rows) {
                 let _ = writeln!(
                     out,
                     "| {} | {:.4e} / {:.4e} | {:.3} | {:.4e} / {:.4e} | {:.3} |",
                     c.name,
-                    r.with.0,
-                    r.bare.0,
-                    r.with.0 / r.bare.0,
-                    r.with.1,
-                    r.bare.1,
-                    r.with.1 / r.bare.1
+                    row.with.0,
+                    row.bare.0,
+                    row.with.0 / row.bare.0,
+                    row.with.1,
+                    row.bare.1,
+                    row.with.1 / row.bare.1
                 );
             }
         }
