@@ -1,11 +1,11 @@
 """Helpers of scripts/design-example: a synthetic ground-motion record, and the PNG plots of
 tld-design's response.csv.
 
-    python scripts/design_example.py record OUT.csv   # 60 s of a Kanai-Tajimi-filtered,
-        # enveloped white noise (seed 3), site 1.25 Hz / 0.6, peak 0.2 m/s^2, then 40 s at rest
-    python scripts/design_example.py plot DIR         # DIR/response.csv -> DIR/response.png
+usage: scripts/design_example.py record OUT.csv   (60 s of Kanai-Tajimi-filtered, enveloped
+           white noise, seed 3, site 1.25 Hz / 0.6, peak 0.2 m/s^2, then 40 s at rest)
+       scripts/design_example.py plot DIR         (DIR/response.csv -> DIR/response.png)
 """
-import sys
+import argparse
 
 import numpy as np
 
@@ -61,4 +61,9 @@ def plot(folder):
 
 
 if __name__ == "__main__":
-    {"record": record, "plot": plot}[sys.argv[1]](sys.argv[2])
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("what", choices=["record", "plot"])
+    parser.add_argument("path", help="the record to write, or the folder to plot")
+    args = parser.parse_args()
+    {"record": record, "plot": plot}[args.what](args.path)
