@@ -1,23 +1,25 @@
-//! Preliminary design of a TLD with damping screens for a structural mode under harmonic
-//! excitation at resonance (after Tait 2008's procedure, with Warburton's optimum), and its
-//! check by co-simulation with the shallow-water model (screens resolved).
+//! Preliminary design of a TLD with damping screens for a structural mode under a design
+//! excitation (a harmonic force at resonance, wind as a white-noise force, a ground-motion
+//! record), after Tait 2008's procedure with Warburton's optima (analysis::excitation), and its
+//! check by co-simulation with the shallow-water model (screens resolved). docs/DESIGN.md.
 //!
 //! 1. The effective mass ratio mu = m_1/M (m_1 the fundamental sloshing mass of all tanks, Eq
-//!    2.1, from the water mass ratio and the depth ratio) gives Warburton's optimum for a
-//!    harmonic force on an undamped structure: frequency ratio gamma = 1/(1 + mu), damping
-//!    zeta_opt = sqrt(3 mu / (8 (1 + mu))).
-//! 2. The design amplitude: the controlled structure's resonant response to the force,
-//!    X = (P/K) sqrt(1 + 2/mu) (Den Hartog's fixed points), is the tank's base amplitude A_e.
+//!    2.1, from the water mass ratio and the depth ratio) gives Warburton's optimum frequency
+//!    ratio gamma and damping zeta_opt for the excitation.
+//! 2. The design response: the tuned mass's response X in the Screens law zeta_s = K X, with the
+//!    optimal linear damper on the structure (harmonic: A_e/(2 zeta_opt), A_e the structure's
+//!    resonant amplitude (P/K) sqrt(1 + 2/mu); wind: 1.880 sigma of the tuned mass; record: its
+//!    peak); the equivalent base amplitude A_e = 2 zeta_opt X.
 //! 3. The tank: length from Eq 2.2 at the depth ratio for the linear frequency
 //!    gamma omega_s / kappa(Lambda), kappa the NSD hardening at Lambda = A_e/a (iterated: a
 //!    depends on the frequency, Lambda on a); shortened to the footprint by a shallower depth
 //!    ratio if needed; breadth and count from the water mass and the largest breadth.
-//! 4. The screens: the Screens law's K that makes zeta(A_e) = zeta_opt,
-//!    K = 2 zeta_opt (zeta_opt - zeta_BL)/A_e, then the loss coefficient
+//! 4. The screens: K = (zeta_opt - zeta_BL)/X, then the loss coefficient
 //!    C_l = K a / ((2/3)(m_1/M_l) sum |sin(pi x_j/a)|^3) and the solidity with that C_l.
 
 use std::f64::consts::PI;
 
+use crate::analysis::excitation::{Optimum, RANDOM_SCREENS, TwoDof, warburton};
 use crate::description::{AmplitudeModeItem, DampingLawItem, ModelKindItem, vr};
 use crate::model::{Damper, Inputs, Output, StartValues};
 use crate::physics::geometry::Tank;
@@ -42,6 +44,44 @@ impl Structure {
 
     pub fn stiffness(&self) -> f64 {
         self.mass * self.omega() * self.omega()
+    }
+}
+
+/// The design excitation (docs/DESIGN.md): what sets Warburton's optimum and the design
+/// amplitude.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Excitation {
+    /// The harmonic force `Structure::force` at resonance.
+    Harmonic,
+    /// Wind: a white-noise modal force of two-sided spectral density `s0` [N^2 s/rad].
+    Wind { s0: f64 },
+    /// A ground-motion record: accelerations [m/s^2] every `step` s; the modal force is
+    /// -`participation` a_g.
+    Record {
+        step: f64,
+        accel: Vec<f64>,
+        participation: f64,
+    },
+}
+
+impl Excitation {
+    /// The wind whose resonant response gives the bare structure the rms acceleration
+    /// `sigma_a` [m/s^2] at the damper's floor: sigma_X = sigma_a/omega^2 (narrow band) and
+    /// sigma_X^2 = pi s0/(K C).
+    pub fn wind_from_rms_accel(s: &Structure, sigma_a: f64) -> Self {
+        let sigma_x = sigma_a / (s.omega() * s.omega());
+        let c = 2.0 * s.damping * s.mass * s.omega();
+        Excitation::Wind {
+            s0: sigma_x * sigma_x * s.stiffness() * c / PI,
+        }
+    }
+
+    fn optimum(&self) -> Optimum {
+        match self {
+            Excitation::Harmonic => Optimum::HarmonicForce,
+            Excitation::Wind { .. } => Optimum::WhiteNoiseForce,
+            Excitation::Record { .. } => Optimum::HarmonicGround,
+        }
     }
 }
 
@@ -77,6 +117,12 @@ pub struct Design {
     pub kappa: f64,
     /// The loss coefficient the screens need.
     pub loss: f64,
+    /// The sloshing mass's response measure X in zeta_s = K X (harmonic: the amplitude
+    /// A_e/(2 zeta_opt); wind: 1.880 sigma of the tuned mass; record: its peak) [m].
+    pub sloshing: f64,
+    /// The structure's predicted response with the optimal linear damper (harmonic: resonant
+    /// amplitude; wind: rms displacement; record: peak displacement) [m].
+    pub predicted: f64,
 }
 
 /// Water at 20 C.
@@ -107,12 +153,28 @@ pub fn solidity_for(c_l: f64) -> Option<f64> {
     Some(0.5 * (lo + hi))
 }
 
-/// The preliminary design (module docs); Err with the reason if the limits cannot be met.
+/// The preliminary design for the harmonic force at resonance.
 pub fn design(s: &Structure, l: &Limits) -> Result<Design, String> {
+    design_for(s, &Excitation::Harmonic, l)
+}
+
+/// The preliminary design (module docs) for the excitation `e`; Err with the reason if the
+/// limits cannot be met.
+pub fn design_for(s: &Structure, e: &Excitation, l: &Limits) -> Result<Design, String> {
+    let force = match e {
+        Excitation::Harmonic => s.force,
+        Excitation::Wind { s0 } => *s0,
+        Excitation::Record { step, accel, .. } => {
+            if accel.len() < 2 || accel.iter().any(|a| !a.is_finite()) {
+                return Err("the record needs at least two finite accelerations".into());
+            }
+            *step
+        }
+    };
     let positive = [
         s.mass,
         s.frequency,
-        s.force,
+        force,
         l.mass_ratio,
         l.length,
         l.breadth,
@@ -129,6 +191,7 @@ pub fn design(s: &Structure, l: &Limits) -> Result<Design, String> {
     let water = l.mass_ratio * s.mass;
     let (mut r, mut kappa, mut a) = (l.depth_ratio, 1.0, 0.0);
     let (mut mu, mut gamma, mut zeta_opt, mut amplitude) = (0.0, 1.0, 0.0, 0.0);
+    let (mut sloshing, mut predicted) = (0.0, 0.0);
     // Fixed point: the mass fraction m_1/M_l depends on r, the length on the frequency and r,
     // kappa on Lambda = A_e/a.
     for _ in 0..50 {
@@ -144,9 +207,10 @@ pub fn design(s: &Structure, l: &Limits) -> Result<Design, String> {
             / r
             / RHO;
         mu = water * fraction / s.mass;
-        gamma = 1.0 / (1.0 + mu);
-        zeta_opt = (3.0 * mu / (8.0 * (1.0 + mu))).sqrt();
-        amplitude = s.force / s.stiffness() * (1.0 + 2.0 / mu).sqrt();
+        (gamma, zeta_opt) = warburton(e.optimum(), mu);
+        (sloshing, predicted) = response_measures(s, e, mu, gamma, zeta_opt)?;
+        // The equivalent harmonic base amplitude: the Screens law's A_e with X = A_e/(2 zeta).
+        amplitude = 2.0 * zeta_opt * sloshing;
         let omega_1 = gamma * s.omega() / kappa;
         a = length_for(omega_1, r);
         if a > l.length {
@@ -211,6 +275,47 @@ pub fn design(s: &Structure, l: &Limits) -> Result<Design, String> {
         amplitude,
         kappa,
         loss,
+        sloshing,
+        predicted,
+    })
+}
+
+/// The sloshing mass's response measure X (zeta_s = K X) and the structure's predicted
+/// response, with the optimal linear damper (mu, gamma, zeta_d) on the structure.
+fn response_measures(
+    s: &Structure,
+    e: &Excitation,
+    mu: f64,
+    gamma: f64,
+    zeta_d: f64,
+) -> Result<(f64, f64), String> {
+    let two = TwoDof {
+        mass: s.mass,
+        omega: s.omega(),
+        zeta: s.damping,
+        mu,
+        gamma,
+        zeta_d,
+    };
+    Ok(match e {
+        Excitation::Harmonic => {
+            // Den Hartog's fixed points: the structure's resonant amplitude is the tank's A_e.
+            let x = s.force / s.stiffness() * (1.0 + 2.0 / mu).sqrt();
+            (x / (2.0 * zeta_d), x)
+        }
+        Excitation::Wind { s0 } => {
+            let (sx, sd) = two.white_noise_rms(*s0)?;
+            // The random Screens law: zeta_s = 1.880 K sigma (MODEL.md 11).
+            (RANDOM_SCREENS * sd, sx)
+        }
+        Excitation::Record {
+            step,
+            accel,
+            participation,
+        } => {
+            let (px, pd) = two.record_peaks(*participation, *step, accel);
+            (pd, px)
+        }
     })
 }
 
@@ -237,22 +342,78 @@ impl Design {
     }
 }
 
-/// The structure (Newmark's average acceleration) carrying `damper` (None: bare) under the
-/// harmonic force `force` sin(w t), swept slowly over `ratios` of its frequency: the steady
-/// displacement amplitude at each (the largest over the last `measure` of `periods` periods
-/// per frequency, `steps` steps per period). The damper is driven by the structure's
-/// acceleration at the start of each step and pushes back with its force.mean over the step
-/// (explicit coupling: stable while the liquid mass is below the structure's).
+/// The structure's mode (Newmark's average acceleration) carrying a damper on its floor. The
+/// damper is driven by the floor's absolute acceleration at the start of each step and pushes
+/// back with its force.mean over the step (explicit coupling: stable while the liquid mass is
+/// below the structure's).
+struct Carrier {
+    m: f64,
+    c: f64,
+    k: f64,
+    damper: Option<Damper>,
+    /// Relative displacement, velocity, acceleration; the ground's velocity; the time.
+    x: f64,
+    v: f64,
+    acc: f64,
+    v_g: f64,
+    t: f64,
+}
+
+impl Carrier {
+    fn new(s: &Structure, damper: Option<Damper>) -> Self {
+        Carrier {
+            m: s.mass,
+            c: 2.0 * s.damping * s.mass * s.omega(),
+            k: s.stiffness(),
+            damper,
+            x: 0.0,
+            v: 0.0,
+            acc: 0.0,
+            v_g: 0.0,
+            t: 0.0,
+        }
+    }
+
+    /// One step of `h`: `p` the modal force at its end (external force and -L a_g), the ground
+    /// acceleration `a_g` at its start and `a_g_next` at its end.
+    fn step(&mut self, h: f64, p: f64, a_g: f64, a_g_next: f64) -> Result<(), String> {
+        let inputs = Inputs {
+            a: self.acc + a_g,
+            v: self.v + self.v_g,
+            a_derivatives: [0.0; 2],
+        };
+        let push = match self.damper.as_mut() {
+            Some(d) => {
+                d.step(self.t, h, &inputs)
+                    .map_err(|e| format!("at t = {:.2} s: {e}", self.t))?;
+                d.output(Output::ForceMean, &inputs)
+            }
+            None => 0.0,
+        };
+        let (m, c, k, x, v, acc) = (self.m, self.c, self.k, self.x, self.v, self.acc);
+        let lhs = m + 0.5 * h * c + 0.25 * h * h * k;
+        let next =
+            (p + push - c * (v + 0.5 * h * acc) - k * (x + h * v + 0.25 * h * h * acc)) / lhs;
+        self.x += h * v + 0.25 * h * h * (acc + next);
+        self.v += 0.5 * h * (acc + next);
+        self.acc = next;
+        self.v_g += 0.5 * h * (a_g + a_g_next);
+        self.t += h;
+        Ok(())
+    }
+}
+
+/// The structure carrying `damper` (None: bare) under the harmonic force `force` sin(w t),
+/// swept slowly over `ratios` of its frequency: the steady displacement amplitude at each (the
+/// largest over the last quarter of `periods` periods per frequency, `steps` steps per period).
 pub fn response(
     s: &Structure,
-    mut damper: Option<Damper>,
+    damper: Option<Damper>,
     ratios: &[f64],
     periods: u32,
     steps: u32,
 ) -> Result<Vec<f64>, String> {
-    let (m, k) = (s.mass, s.stiffness());
-    let c = 2.0 * s.damping * m * s.omega();
-    let (mut x, mut v, mut acc, mut t) = (0.0, 0.0, 0.0, 0.0);
+    let mut carrier = Carrier::new(s, damper);
     let measure = (periods / 4).max(1);
     let mut out = Vec::with_capacity(ratios.len());
     for &ratio in ratios {
@@ -261,33 +422,67 @@ pub fn response(
         let mut largest: f64 = 0.0;
         // The phase restarts at each frequency after whole periods: the force stays smooth.
         for n in 0..periods * steps {
-            let inputs = Inputs {
-                a: acc,
-                v,
-                a_derivatives: [0.0; 2],
-            };
-            let push = match damper.as_mut() {
-                Some(d) => {
-                    d.step(t, h, &inputs)
-                        .map_err(|e| format!("at t = {t:.2} s: {e}"))?;
-                    d.output(Output::ForceMean, &inputs)
-                }
-                None => 0.0,
-            };
-            let p = s.force * (w * h * f64::from(n % steps + 1)).sin() + push;
-            let lhs = m + 0.5 * h * c + 0.25 * h * h * k;
-            let next = (p - c * (v + 0.5 * h * acc) - k * (x + h * v + 0.25 * h * h * acc)) / lhs;
-            x += h * v + 0.25 * h * h * (acc + next);
-            v += 0.5 * h * (acc + next);
-            acc = next;
-            t += h;
+            let p = s.force * (w * h * f64::from(n % steps + 1)).sin();
+            carrier.step(h, p, 0.0, 0.0)?;
             if n >= (periods - measure) * steps {
-                largest = largest.max(x.abs());
+                largest = largest.max(carrier.x.abs());
             }
         }
         out.push(largest);
     }
     Ok(out)
+}
+
+/// The structure carrying `damper` (None: bare) under the modal force `force[n]` and the
+/// ground acceleration `a_g[n]` (modal force -`participation` a_g) at t = n h: its relative
+/// displacement at each t (the same length as the inputs).
+pub fn history(
+    s: &Structure,
+    damper: Option<Damper>,
+    h: f64,
+    force: &[f64],
+    a_g: &[f64],
+    participation: f64,
+) -> Result<Vec<f64>, String> {
+    if force.len() != a_g.len() || h.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return Err("force and ground acceleration on the same grid, h > 0".into());
+    }
+    let mut carrier = Carrier::new(s, damper);
+    let mut out = Vec::with_capacity(force.len());
+    out.push(0.0);
+    for n in 1..force.len() {
+        let p = force[n] - participation * a_g[n];
+        carrier.step(h, p, a_g[n - 1], a_g[n])?;
+        out.push(carrier.x);
+    }
+    Ok(out)
+}
+
+/// A realisation of a band-limited white-noise force of two-sided spectral density `s0`
+/// [N^2 s/rad] between `band` [rad/s] on t = n h, n < `count`: a sum of cosines at the
+/// multiples of 2 pi/(count h) in the band, amplitudes sqrt(4 s0 dw) (one-sided density
+/// 2 s0), phases uniform from `seed` (SplitMix64).
+pub fn wind_force(s0: f64, band: (f64, f64), h: f64, count: usize, seed: u64) -> Vec<f64> {
+    let dw = 2.0 * PI / (count as f64 * h);
+    let mut state = seed;
+    let mut uniform = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        (z ^ (z >> 31)) as f64 / u64::MAX as f64
+    };
+    let first = (band.0 / dw).ceil().max(1.0) as usize;
+    let last = (band.1 / dw).floor() as usize;
+    let amplitude = (4.0 * s0 * dw).sqrt();
+    let mut out = vec![0.0; count];
+    for j in first..=last {
+        let (w, phase) = (j as f64 * dw, 2.0 * PI * uniform());
+        for (n, f) in out.iter_mut().enumerate() {
+            *f += amplitude * (w * h * n as f64 + phase).cos();
+        }
+    }
+    out
 }
 
 /// Configure the shallow-water damper of `design` on `cells` cells.
@@ -381,5 +576,122 @@ mod tests {
         let x = response(&s, None, &[1.0], 400, 64).expect("run")[0];
         let want = s.force / (2.0 * s.damping * s.stiffness());
         assert!((x / want - 1.0).abs() < 0.01, "{x} vs {want}");
+    }
+
+    /// The realisation's variance is the band's: 2 s0 (w_2 - w_1) to the grid's resolution
+    /// (the cosines are orthogonal over the whole record), and the seed fixes it.
+    #[test]
+    fn wind_force_has_the_band_variance() {
+        let (s0, band, h, count) = (2.0e6, (0.5, 3.0), 0.05, 40000);
+        let f = wind_force(s0, band, h, count, 7);
+        let var = f.iter().map(|v| v * v).sum::<f64>() / count as f64;
+        let dw = 2.0 * PI / (count as f64 * h);
+        let lines = ((band.1 / dw).floor() - (band.0 / dw).ceil() + 1.0) * dw;
+        assert!((var / (2.0 * s0 * lines) - 1.0).abs() < 1e-9, "{var}");
+        assert_eq!(f, wind_force(s0, band, h, count, 7));
+        assert_ne!(f, wind_force(s0, band, h, count, 8));
+    }
+
+    /// For wind: Warburton's white-noise optimum, and the random Screens law
+    /// zeta_BL + 1.880 K sigma_d = zeta_opt at the tuned mass's rms; the co-simulated tanks
+    /// (24 cells, 1600 s of one realisation) hold the structure's rms displacement to the
+    /// linear prediction within 15 % and below 0.6 of the bare structure's under the same force.
+    #[test]
+    fn wind_design_meets_its_targets_and_holds_the_rms() {
+        let (s, l) = building();
+        let e = Excitation::wind_from_rms_accel(&s, 0.05);
+        let d = design_for(&s, &e, &l).expect("design");
+        let (g, z) = warburton(Optimum::WhiteNoiseForce, d.mu);
+        assert!(d.gamma == g && d.zeta_opt == z);
+        let w1 = d.tank.fundamental().omega;
+        assert!((w1 * d.kappa / (g * s.omega()) - 1.0).abs() < 1e-9);
+        let k = d.screens.zeta_per_response(
+            d.tank.length,
+            d.tank.fundamental().mass / d.tank.liquid_mass(),
+        );
+        assert!((d.zeta_bl + k * d.sloshing - d.zeta_opt).abs() < 1e-9 * d.zeta_opt);
+        // The response the screens are sized for is 1.880 times the tuned mass's rms.
+        let Excitation::Wind { s0 } = e else {
+            unreachable!()
+        };
+        let two = TwoDof {
+            mass: s.mass,
+            omega: s.omega(),
+            zeta: s.damping,
+            mu: d.mu,
+            gamma: d.gamma,
+            zeta_d: d.zeta_opt,
+        };
+        let (sx, sd) = two.white_noise_rms(s0).expect("stable");
+        assert!((d.sloshing / sd - 1.880).abs() < 1e-3 && d.predicted == sx);
+        let h = 1.0 / s.frequency / 64.0;
+        let count = (1600.0 / h) as usize;
+        let f = wind_force(s0, (0.3 * s.omega(), 3.0 * s.omega()), h, count, 1);
+        let zero = vec![0.0; count];
+        let rms = |x: &[f64]| {
+            let tail = &x[x.len() / 8..];
+            (tail.iter().map(|v| v * v).sum::<f64>() / tail.len() as f64).sqrt()
+        };
+        let with = history(&s, Some(damper(&d, 24).expect("damper")), h, &f, &zero, 0.0);
+        let with = rms(&with.expect("run"));
+        let bare = rms(&history(&s, None, h, &f, &zero, 0.0).expect("run"));
+        eprintln!(
+            "wind: rms {with:.4e} m, predicted {:.4e} m, bare {bare:.4e} m",
+            d.predicted
+        );
+        assert!(
+            (with / d.predicted - 1.0).abs() < 0.15,
+            "{with} vs {}",
+            d.predicted
+        );
+        assert!(with < 0.6 * bare);
+    }
+
+    /// For a ground-motion record (here 40 periods of a resonant sine of ground
+    /// acceleration, 0.005 m/s^2, then free decay; participation 1.3 M): Warburton's ground
+    /// optimum; the co-simulated tanks hold the structure's peak to the linear prediction
+    /// within 15 % (measured +8 %) and below 0.8 of the bare structure's. At four times the
+    /// record (tuned-mass excursions of 0.6 m in a 5 m tank) the shallow-water tanks let the
+    /// structure reach +36 % over the linear prediction: the design is linear.
+    #[test]
+    fn record_design_holds_the_peak() {
+        let (s, l) = building();
+        let step = 0.04;
+        let accel: Vec<f64> = (0..2000)
+            .map(|n| {
+                let t = step * n as f64;
+                if t < 40.0 / s.frequency {
+                    0.005 * (s.omega() * t).sin()
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let participation = 1.3 * s.mass;
+        let e = Excitation::Record {
+            step,
+            accel: accel.clone(),
+            participation,
+        };
+        let d = design_for(&s, &e, &l).expect("design");
+        assert_eq!(
+            (d.gamma, d.zeta_opt),
+            warburton(Optimum::HarmonicGround, d.mu)
+        );
+        let zero = vec![0.0; accel.len()];
+        let peak = |x: Vec<f64>| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let dmp = Some(damper(&d, 24).expect("damper"));
+        let with = peak(history(&s, dmp, step, &zero, &accel, participation).expect("run"));
+        let bare = peak(history(&s, None, step, &zero, &accel, participation).expect("run"));
+        eprintln!(
+            "record: peak {with:.4e} m, predicted {:.4e} m, bare {bare:.4e} m",
+            d.predicted
+        );
+        assert!(
+            (with / d.predicted - 1.0).abs() < 0.15,
+            "{with} vs {}",
+            d.predicted
+        );
+        assert!(with < 0.8 * bare);
     }
 }

@@ -6,6 +6,7 @@
 pub mod calibration;
 pub mod coupled;
 pub mod design;
+pub mod excitation;
 pub mod harmonic;
 pub mod linearisation;
 pub mod random;

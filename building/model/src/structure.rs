@@ -42,6 +42,17 @@ pub struct Design {
     pub ground: Harmonic,
 }
 
+/// The first mode, normalised to 1 at the damper's floor (Building::first_mode).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FirstMode {
+    pub shape: Vec<f64>,
+    /// Generalised mass [kg], circular frequency [rad/s], damping ratio, participation [kg].
+    pub mass: f64,
+    pub omega: f64,
+    pub damping: f64,
+    pub participation: f64,
+}
+
 /// A harmonic ground displacement x_g = amplitude sin(omega t).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Harmonic {
@@ -125,6 +136,40 @@ impl Building {
             beta,
             damper: d.damper_floor - 1,
             ground: d.ground,
+        })
+    }
+
+    /// The first mode as a damper designer sees it from the damper's floor: the shape
+    /// normalised to 1 there, the generalised (modal) mass phi^T M phi, the frequency, the
+    /// damping ratio phi^T C phi / (2 omega phi^T M phi) and the participation factor
+    /// L = phi^T M 1 (the modal force of a ground acceleration a_g is -L a_g).
+    pub fn first_mode(&self) -> Result<FirstMode, String> {
+        let n = self.n;
+        let s = self.mass.map(|m| 1.0 / m.sqrt());
+        let scaled = DMatrix::from_fn(n, n, |i, j| self.stiffness[(i, j)] * s[i] * s[j]);
+        let eig = SymmetricEigen::new(scaled);
+        let k = (0..n)
+            .min_by(|a, b| eig.eigenvalues[*a].total_cmp(&eig.eigenvalues[*b]))
+            .ok_or("no storeys")?;
+        let shape = eig.eigenvectors.column(k).component_mul(&s);
+        let at = shape[self.damper];
+        if at.abs() < 1e-9 * shape.amax() {
+            return Err(format!(
+                "floor {} does not move in the first mode: no damper works there",
+                self.damper + 1
+            ));
+        }
+        let shape = shape / at;
+        let mass = shape.dot(&shape.component_mul(&self.mass));
+        let omega = eig.eigenvalues[k].max(0.0).sqrt();
+        let damping = shape.dot(&(&self.damping * &shape)) / (2.0 * omega * mass);
+        let participation = shape.dot(&self.mass);
+        Ok(FirstMode {
+            shape: shape.iter().copied().collect(),
+            mass,
+            omega,
+            damping,
+            participation,
         })
     }
 
@@ -268,6 +313,47 @@ mod tests {
             },
         })
         .expect("a valid design")
+    }
+
+    /// The first mode from the damper's floor against closed forms: one storey (M = m,
+    /// omega^2 = k/m, L = m); two equal storeys (m, k): omega^2 = (3 - sqrt 5)/2 k/m, roof
+    /// normalised shape [(sqrt 5 - 1)/2, 1], M = m (1 + 0.382), L = m (1.618); normalised at
+    /// floor 1 instead, everything scales by 1/0.618 (M by its square).
+    #[test]
+    fn first_mode_against_closed_forms() {
+        let one = |floor: usize, masses: Vec<f64>, stiffnesses: Vec<f64>| {
+            Building::new(&Design {
+                masses,
+                stiffnesses,
+                zeta: [0.02, 0.03],
+                damper_floor: floor,
+                damper_mass: 0.0,
+                ground: Harmonic::default(),
+            })
+            .expect("valid")
+            .first_mode()
+            .expect("mode")
+        };
+        let close = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-12;
+        let m = one(1, vec![3.0e5], vec![2.0e7]);
+        assert!(close(m.mass, 3.0e5) && close(m.participation, 3.0e5));
+        assert!(close(m.omega, (2.0e7_f64 / 3.0e5).sqrt()) && close(m.damping, 0.02));
+        let (mm, kk) = (5.0e4, 8.0e6);
+        let r = (5.0_f64.sqrt() - 1.0) / 2.0;
+        let roof = one(2, vec![mm, mm], vec![kk, kk]);
+        assert!(close(
+            roof.omega,
+            ((3.0 - 5.0_f64.sqrt()) / 2.0 * kk / mm).sqrt()
+        ));
+        assert!(close(roof.shape[0], r) && close(roof.shape[1], 1.0));
+        assert!(close(roof.mass, mm * (1.0 + r * r)));
+        assert!(close(roof.participation, mm * (1.0 + r)));
+        // Rayleigh damping fixed at mode 1: its ratio comes back.
+        assert!(close(roof.damping, 0.02), "{}", roof.damping);
+        let low = one(1, vec![mm, mm], vec![kk, kk]);
+        assert!(close(low.mass, roof.mass / (r * r)));
+        assert!(close(low.participation, roof.participation / r));
+        assert!(close(low.omega, roof.omega));
     }
 
     /// Two storeys: omega^2 are the roots of det(K - w^2 M) = 0, written out by hand.
