@@ -495,7 +495,6 @@ builds! {
     ) -> Result<Advanced, SolveError>;
 }
 
-
 /// What a communication step did, per unit breadth and density.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Advanced {
