@@ -9,6 +9,7 @@
 mod nonlinear;
 mod shallow_water;
 mod slamming;
+mod state;
 
 use super::{Damper, Inputs, Output, StartValues};
 use crate::description::vr;
