@@ -166,3 +166,61 @@ fn refused_steps_say_why() {
     let chattering = StepError::Chattering("impacts without end".into()).to_string();
     assert_eq!(chattering, "impacts without end");
 }
+
+/// The models' own limits, at and just past them: the modes the linear model carries (1 to
+/// the declared maximum), the S^2 clearance (up to the tank length), the shallow-water cells
+/// (2 or more, below the declared 4) and depth (h/a up to 0.3), and the shallow-water start
+/// (a fundamental-mode surface at the walls below the depth).
+#[test]
+fn the_models_limits_hold_at_their_ends() {
+    let ok = |p: &StartValues| Damper::configure(p).is_ok();
+    let linear = StartValues::default().with(vr::MODEL, LINEAR);
+    let most = f64::from(crate::description::limits::MODES_MAX);
+    assert!(ok(&linear.clone().with(vr::MODES, 1.0)));
+    assert!(ok(&linear.clone().with(vr::MODES, most)));
+    assert!(!ok(&linear.clone().with(vr::MODES, 0.0)));
+    assert!(!ok(&linear.clone().with(vr::MODES, most + 1.0)));
+    let s2 = StartValues::default()
+        .with(vr::MODEL, SLAMMING)
+        .with(vr::SLAMMING_OMEGA, 0.9);
+    assert!(ok(&s2.clone().with(vr::SLAMMING_CLEARANCE, A)));
+    assert!(!ok(&s2
+        .clone()
+        .with(vr::SLAMMING_CLEARANCE, A * (1.0 + 1e-12))));
+    let swe = StartValues::default().with(vr::MODEL, 5.0);
+    assert!(ok(&swe.clone().with(vr::SWE_CELLS, 2.0)));
+    assert!(!ok(&swe.clone().with(vr::SWE_CELLS, 1.0)));
+    // h/a = 0.3 exactly (a = 0.25 m, h = 0.075 m) and just above.
+    assert!(ok(&swe.clone().with(vr::TANK_DEPTH, 0.075)));
+    assert!(!ok(&swe.clone().with(vr::TANK_DEPTH, 0.0751)));
+    // The wall height pi^2 m_1 x0 / (2 rho b a^2) of the start against the depth.
+    let reach = -surface_per_x();
+    assert!(ok(&swe.clone().with(vr::SLOSH_X0, 0.99 * H / reach)));
+    assert!(!ok(&swe.clone().with(vr::SLOSH_X0, 1.01 * H / reach)));
+    assert!(!ok(&swe.clone().with(vr::SLOSH_X0, -1.01 * H / reach)));
+}
+
+/// A saved shallow-water state is taken only if it holds this tank's liquid: no negative depth,
+/// the still volume to 1e-9.
+#[test]
+fn shallow_water_states_of_other_liquid_are_refused() {
+    let p = StartValues::default()
+        .with(vr::MODEL, 5.0)
+        .with(vr::SWE_CELLS, 10.0);
+    let sim = damper(&p);
+    let good = sim.snapshot();
+    // Depths first: move liquid from cell 0 to cell 1 (the volume kept), or add some.
+    let moved = |dh: f64, extra: f64| {
+        let mut s = good.clone();
+        s[0] -= dh;
+        s[1] += dh + extra;
+        Damper::restore(&p, &s)
+    };
+    assert!(moved(0.5 * H, 0.0).is_ok());
+    let restored = moved(H, 0.0).expect("a dry cell");
+    assert!(restored.output(Output::SurfaceLeft, &Inputs::default()) < 0.0);
+    assert!(moved(1.0001 * H, 0.0).is_err(), "a negative depth");
+    assert!(moved(0.0, 1e-6 * H).is_err(), "more liquid");
+    assert!(moved(0.0, -1e-6 * H).is_err(), "less liquid");
+    assert!(moved(0.0, 1e-12 * H).is_ok(), "round-off");
+}
