@@ -210,15 +210,25 @@ impl Mode {
     }
 }
 
+/// Tracked amplitude: the filter's time constant (0: two sloshing periods) and whether the host
+/// gives base.v (else the tracker rebuilds it).
+#[derive(Clone, Copy, Debug)]
+struct Tracking {
+    tau: f64,
+    measured: bool,
+}
+
 /// Model = Linear with `modes` modes and `tanks` tanks, held inputs that change every step,
 /// amplitude fixed or tracked: every output and rate against the closed form.
-fn linear_run(modes: u32, tanks: u32, tracked: bool) {
+fn linear_run(modes: u32, tanks: u32, tracking: Option<Tracking>) {
+    let tracked = tracking.is_some();
     let a_e = 0.004;
     let p = StartValues::default()
         .with(vr::MODEL, LINEAR)
         .with(vr::MODES, f64::from(modes))
         .with(vr::TANKS, f64::from(tanks))
         .with(vr::AMPLITUDE, if tracked { TRACKED } else { FIXED })
+        .with(vr::AMPLITUDE_TAU, tracking.map_or(0.0, |t| t.tau))
         .with(vr::A_E, a_e)
         .with(vr::SLOSH_X0, 0.004)
         .with(vr::SLOSH_V0, -0.01);
@@ -238,12 +248,18 @@ fn linear_run(modes: u32, tanks: u32, tracked: bool) {
     // The tracker is the physics' own (tested there); what is checked is that its estimate sets
     // the damping of the step and the outputs.
     let w1 = natural(1).1;
-    let mut tracker = tracked.then(|| {
-        crate::physics::amplitude::AmplitudeTracker::new(2.0 * 2.0 * PI / w1, 0.05 * w1, a_e)
+    let mut tracker = tracking.map(|t| {
+        let tau = if t.tau > 0.0 {
+            t.tau
+        } else {
+            2.0 * 2.0 * PI / w1
+        };
+        crate::physics::amplitude::AmplitudeTracker::new(tau, 0.05 * w1, a_e)
     });
+    let measured = tracking.is_some_and(|t| t.measured);
     let mut amplitude = a_e;
     let mut zeta = nsd_zeta(a_e);
-    let what = format!("Linear, {modes} modes, {tanks} tanks, tracked {tracked}");
+    let what = format!("Linear, {modes} modes, {tanks} tanks, tracking {tracking:?}");
     let mut history = History::new(&what);
     let h = 0.02;
     let mut base_v = 0.0;
@@ -252,7 +268,7 @@ fn linear_run(modes: u32, tanks: u32, tracked: bool) {
         let a = -0.004 * (1.1 * w1).powi(2) * (1.1 * w1 * t).sin() + 0.3 * (0.37 * t).cos();
         let inputs = Inputs {
             a,
-            v: if tracked { base_v } else { 0.0 },
+            v: if measured { base_v } else { 0.0 },
             ..Inputs::default()
         };
         base_v += a * h;
@@ -336,9 +352,11 @@ fn linear_run(modes: u32, tanks: u32, tracked: bool) {
 
 #[test]
 fn linear_outputs_are_the_closed_form() {
-    linear_run(1, 1, false);
-    linear_run(3, 2, false);
-    linear_run(2, 3, true);
+    linear_run(1, 1, None);
+    linear_run(3, 2, None);
+    for (tau, measured) in [(0.0, true), (1.5, true), (0.0, false)] {
+        linear_run(2, 3, Some(Tracking { tau, measured }));
+    }
 }
 
 /// The calculated masses of the linear model: all tanks, the modal masses summed.

@@ -224,3 +224,40 @@ fn shallow_water_states_of_other_liquid_are_refused() {
     assert!(moved(0.0, -1e-6 * H).is_err(), "less liquid");
     assert!(moved(0.0, 1e-12 * H).is_ok(), "round-off");
 }
+
+/// A step is refused as a runaway beyond 100 tank lengths (25 m here), not before: the linear
+/// model driven by a static deflection of 35 m (or 20 m) for a quarter period.
+#[test]
+fn a_runaway_is_a_hundred_tank_lengths() {
+    let w = natural(1).1;
+    let p = StartValues::default()
+        .with(vr::MODEL, LINEAR)
+        .with(vr::DAMPING, CONSTANT)
+        .with(vr::ZETA, 0.01);
+    let quarter = 0.5 * PI / w;
+    let mut sim = damper(&p);
+    let r = sim.step(
+        0.0,
+        quarter,
+        &Inputs {
+            a: -35.0 * w * w,
+            ..Inputs::default()
+        },
+    );
+    match r {
+        Err(StepError::Runaway { x, limit }) => {
+            assert_eq!(limit, 100.0 * A);
+            assert!(x > 30.0 && x < 35.0, "{x}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let r = sim.step(
+        0.0,
+        quarter,
+        &Inputs {
+            a: -20.0 * w * w,
+            ..Inputs::default()
+        },
+    );
+    assert!(r.expect("20 m is no runaway").implausible);
+}
