@@ -261,3 +261,37 @@ fn a_runaway_is_a_hundred_tank_lengths() {
     );
     assert!(r.expect("20 m is no runaway").implausible);
 }
+
+/// The notice of implausible motion names the numbers: above 10 g of base acceleration the
+/// acceleration in g, up to 10 g (5 g, exactly 10 g) the displacement against the walls; once
+/// per run. A runaway check at exactly its limit passes.
+#[test]
+fn notices_name_the_numbers() {
+    let w = natural(1).1;
+    let p = StartValues::default().with(vr::MODEL, LINEAR);
+    let quarter = 0.5 * PI / w;
+    let driven = || {
+        let mut sim = damper(&p);
+        let inputs = Inputs {
+            a: -20.0 * w * w,
+            ..Inputs::default()
+        };
+        assert!(sim.step(0.0, quarter, &inputs).expect("step").implausible);
+        sim
+    };
+    let mut sim = driven();
+    let said = sim.notice(20.0 * 9.81).expect("a notice");
+    assert!(said.contains("is 20 g"), "{said}");
+    assert_eq!(sim.notice(20.0 * 9.81), None);
+    for a in [50.0, 10.0 * 9.81] {
+        let mut sim = driven();
+        let x = sim.output(Output::X, &Inputs::default());
+        let said = sim.notice(a).expect("a notice");
+        let expected = format!("slosh.x = {x:.3} m in a tank 0.25 m long (walls at +-0.125 m)");
+        assert!(said.starts_with(&expected), "{said}");
+    }
+    assert!(crate::model::check_runaway(25.0, 25.0).is_ok());
+    assert!(crate::model::check_runaway(-25.0, 25.0).is_ok());
+    assert!(crate::model::check_runaway(25.000000000000004, 25.0).is_err());
+    assert!(crate::model::check_runaway(f64::NAN, 25.0).is_err());
+}
