@@ -295,3 +295,31 @@ fn notices_name_the_numbers() {
     assert!(crate::model::check_runaway(25.000000000000004, 25.0).is_err());
     assert!(crate::model::check_runaway(f64::NAN, 25.0).is_err());
 }
+
+/// A shallow-water step refused (more substeps than allowed) leaves the damper as it was.
+#[test]
+fn a_refused_shallow_water_step_changes_nothing() {
+    let p = StartValues::default()
+        .with(vr::MODEL, 5.0)
+        .with(vr::SWE_CELLS, 20.0)
+        .with(vr::SOLVER_MAX_SUBSTEPS, 2.0)
+        .with(vr::SLOSH_X0, 0.001);
+    let mut sim = damper(&p);
+    sim.step(0.0, 0.001, &Inputs::default())
+        .expect("a short step");
+    let before = sim.clone();
+    assert_eq!(sim, before);
+    let r = sim.step(
+        0.001,
+        1.0,
+        &Inputs {
+            a: 0.1,
+            ..Inputs::default()
+        },
+    );
+    assert!(
+        matches!(r, Err(StepError::Solver(SolveError::TooManySteps { .. }))),
+        "{r:?}"
+    );
+    assert_eq!(sim, before);
+}
