@@ -54,6 +54,22 @@ fn every_solver_item_takes_the_steps_it_names() {
             (1, 0, 0)
         );
     }
+    // The shallow-water substeps: SSPRK(10,4), ten right-hand sides each, taken or not.
+    let p = StartValues::default()
+        .with(vr::MODEL, 5.0)
+        .with(vr::SWE_CELLS, 20.0);
+    let mut sim = damper(&p);
+    let r = sim.step(
+        0.0,
+        0.3,
+        &Inputs {
+            a: 0.2,
+            ..Inputs::default()
+        },
+    );
+    let stats = r.expect("step").stats;
+    assert!(stats.accepted > 1, "{stats:?}");
+    assert_eq!(stats.evaluations, 10 * (stats.accepted + stats.rejected));
 }
 
 /// ExpRK4 advances the linear oscillator by its exact flow: with no hardening (phi = 0) and no
