@@ -113,7 +113,7 @@ fn a_restored_state_continues_bit_for_bit() {
                 StartValues::default()
                     .with(vr::MODEL, m)
                     .with(vr::SOLVER, s)
-                    .with(vr::SOLVER_TOLERANCE, 1e-7)
+                    .with(vr::SOLVER_TOLERANCE, 1e-11)
                     .with(vr::AUTO_THRESHOLD, 1e-4)
             })
         })
