@@ -340,3 +340,23 @@ fn a_refused_shallow_water_step_changes_nothing() {
     );
     assert_eq!(sim, before);
 }
+
+/// S^2's impact mass may take all the liquid the sloshing mode leaves, not more: a mass ratio
+/// for which (1 + ratio) m_1 is the liquid mass to the last bit is accepted, the next one up
+/// refused.
+#[test]
+fn slamming_mass_ratio_may_take_all_the_liquid() {
+    let (m1, _) = natural(1);
+    let p = StartValues::default()
+        .with(vr::MODEL, SLAMMING)
+        .with(vr::SLAMMING_OMEGA, 0.9);
+    // The ratio near M_l/m_1 - 1 whose sloshing mass equals the liquid's exactly.
+    let start = liquid() / m1 - 1.0;
+    let exact = (-50..=50)
+        .map(|k| f64::from_bits((start.to_bits() as i64 + k) as u64))
+        .find(|r| liquid() - (m1 + r * m1) == 0.0)
+        .expect("a ratio that takes all the liquid");
+    let ok = |r: f64| Damper::configure(&p.clone().with(vr::SLAMMING_MASS_RATIO, r)).is_ok();
+    assert!(ok(exact), "{exact}");
+    assert!(!ok(exact * (1.0 + 1e-12)));
+}
