@@ -159,6 +159,14 @@ impl History {
     }
 }
 
+/// A held base acceleration `a`.
+fn held(a: f64) -> Inputs {
+    Inputs {
+        a,
+        ..Inputs::default()
+    }
+}
+
 fn damper(p: &StartValues) -> Damper {
     Damper::configure(p).expect("configuration").0
 }
