@@ -207,3 +207,25 @@ fn every_variable_is_wired_to_its_quantity() {
         close(rates[4], surface * v, 0.01 * w, "der(surface.left)");
     }
 }
+
+/// fmi2SetupExperiment with a stop time: taken when it is finite and not before the start,
+/// refused (fmi2Error) otherwise.
+#[test]
+fn setup_experiment_takes_a_stop_time() {
+    for (start, stop, ok) in [
+        (0.0, 10.0, true),
+        (2.0, 2.0, true),
+        (2.0, 1.0, false),
+        (0.0, f64::NAN, false),
+        (0.0, f64::INFINITY, false),
+    ] {
+        let inst = Instance::new("stop-time");
+        let status = unsafe { inst.lib.fmi2SetupExperiment(inst.c, 0, 0.0, start, 1, stop) };
+        assert_eq!(
+            status == OK,
+            ok,
+            "start {start} stop {stop}: {:?}",
+            inst.logs()
+        );
+    }
+}

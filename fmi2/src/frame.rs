@@ -288,6 +288,20 @@ mod tests {
         }
     }
 
+    /// A list that claims more numbers than the rest of the state holds is refused as such
+    /// before it is read, wherever it stands in the state.
+    #[test]
+    fn a_list_longer_than_the_state_is_refused_before_reading() {
+        let (common, _) = sample();
+        let bytes = encode(TAG, 3, GUID, &common, |out| {
+            out.extend_from_slice(&3u32.to_le_bytes());
+            out.extend_from_slice(&[0u8; 16]);
+        });
+        let (_, mut part) = decode(&bytes, TAG, 3, GUID, "Test").expect("a good frame");
+        let why = part.f64_list().expect_err("three numbers in 16 bytes");
+        assert!(why.contains("a list is longer than the buffer"), "{why}");
+    }
+
     /// Every kind of damage is named: tag, version, GUID, checksum, truncation, trailing bytes.
     #[test]
     fn a_damaged_frame_says_what_is_wrong() {
