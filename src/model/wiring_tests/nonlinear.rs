@@ -252,7 +252,8 @@ fn auto_outputs_are_the_reference_integration() {
 /// a ramp, a parabola, or an input whose terms cancel at the step's end; through the centre
 /// fast; with a free oscillation and an input whose deflections cancel; a step of 2/omega_f
 /// (the static deflection 2/omega^2 equal to h/omega); and a small input just above the
-/// threshold. The state after every step is the nonlinear one: x, v, force.
+/// threshold; a 10 s step under a slow parabola. The state after every step is the nonlinear
+/// one: x, v, force.
 #[test]
 fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
     let w = natural(1).1;
@@ -267,7 +268,7 @@ fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
     let c = 2.0 * nsd_zeta(a_e) * w;
     let mass = natural(1).0;
     // (x0, v0, step, input): the hardening phi (2|x|/a)^2 reaches 1e-6 at |x| = 1.25e-4 m.
-    let cases: [(f64, f64, f64, [f64; 3]); 13] = [
+    let cases: [(f64, f64, f64, [f64; 3]); 14] = [
         (1e-5, 0.0, 0.05, [1e-4, 0.0, 0.0]),
         (0.0, 1e-5 * w, 0.05, [0.0, 0.0, 0.0]),
         (-1e-5, 0.0, 0.05, [0.0, 1e-3, 0.0]),
@@ -281,6 +282,8 @@ fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
         (0.03, 0.0, 0.1, [-0.373, 0.0, 0.0]),
         (0.0, 0.0, 2.0 / w, [1.0, 0.0, 0.0]),
         (0.0, 0.0, 0.4, [0.0039, 0.0, 0.0]),
+        // A 10 s step under a slow parabola: the input's bound must grow as h^2.
+        (0.0, 0.0, 10.0, [0.0, 0.0, 1.1e-4]),
     ];
     for (x0, v0, h, a) in cases {
         let q = p.clone().with(vr::SLOSH_X0, x0).with(vr::SLOSH_V0, v0);
@@ -298,7 +301,9 @@ fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
         for k in 0..n {
             let s = h * f64::from(k) / f64::from(n);
             let shifted = [a[0] + s * (a[1] + 0.5 * s * a[2]), a[1] + s * a[2], a[2]];
-            y = law.rk4(c, shifted, h / f64::from(n), 4, y);
+            // RK4 steps of at most 1 ms.
+            let m = (h / f64::from(n) / 1e-3).ceil().max(4.0) as u32;
+            y = law.rk4(c, shifted, h / f64::from(n), m, y);
             largest = largest.max(law.hardening(y[0]));
         }
         let what =
