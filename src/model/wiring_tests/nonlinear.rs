@@ -310,6 +310,11 @@ fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
             format!("x0 {x0} v0 {v0} h {h} a {a:?}: hardening up to {largest:e}, {report:?}");
         let linear = report.stats.evaluations == 0;
         if linear {
+            assert_eq!(
+                (report.stats.accepted, report.stats.rejected),
+                (1, 0),
+                "{what}"
+            );
             assert!(largest < 0.1 * threshold, "{what}: linear step taken");
         } else {
             assert!(largest > threshold, "{what}: linear step refused");

@@ -97,7 +97,8 @@ fn slamming_run(omega_parameter: f64, omega: f64, tanks: f64) {
         .with(vr::SLAMMING_RESTITUTION, E)
         .with(vr::SLAMMING_CLEARANCE, CLEARANCE)
         .with(vr::SLAMMING_MASS_RATIO, MASS_RATIO)
-        .with(vr::SLOSH_X0, 0.004);
+        .with(vr::SLOSH_X0, 0.004)
+        .with(vr::SLOSH_V0, -0.01);
     let mut sim = damper(&p);
     let (m1, w1) = natural(1);
     let zeta = nsd_zeta(a_e);
@@ -111,6 +112,7 @@ fn slamming_run(omega_parameter: f64, omega: f64, tanks: f64) {
     let mut mode = Mode {
         w: w1 / omega.sqrt(),
         x: 0.004,
+        v: -0.01,
         ..Mode::default()
     };
     let mut imp = Impact::default();
