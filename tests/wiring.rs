@@ -228,4 +228,61 @@ fn setup_experiment_takes_a_stop_time() {
             inst.logs()
         );
     }
+    for (tolerance, ok) in [
+        (1e-6, true),
+        (0.0, false),
+        (-1e-6, false),
+        (f64::NAN, false),
+    ] {
+        let inst = Instance::new("tolerance");
+        let status = unsafe {
+            inst.lib
+                .fmi2SetupExperiment(inst.c, 1, tolerance, 0.0, 0, 0.0)
+        };
+        assert_eq!(status == OK, ok, "tolerance {tolerance}: {:?}", inst.logs());
+    }
+}
+
+/// An instance at `start`, stopping at `stop`, ready to step.
+fn started(name: &str, start: f64, stop: f64) -> Instance {
+    let mut inst = Instance::new(name);
+    let status = unsafe { inst.lib.fmi2SetupExperiment(inst.c, 0, 0.0, start, 1, stop) };
+    assert_eq!(status, OK, "{:?}", inst.logs());
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.exit(), OK);
+    inst.time = start;
+    inst
+}
+
+/// fmi2DoStep takes the host's time with its rounding (1e-9 relative, here 1e-3 s at 1e6 s,
+/// and 1e-6 of the step), not more; it reaches the stop time, to the same slack, not beyond.
+#[test]
+fn do_step_takes_the_hosts_rounding_and_stops_at_the_stop_time() {
+    let step = |inst: &Instance, t: f64, h: f64| unsafe { inst.lib.fmi2DoStep(inst.c, t, h, 1) };
+    let at = 1e6;
+    for (offset, ok) in [(5e-4, true), (-5e-4, true), (2e-3, false), (-2e-3, false)] {
+        let inst = started("rounding", at, 2e6);
+        let status = step(&inst, at + offset, 0.01);
+        assert_eq!(status == OK, ok, "offset {offset}: {:?}", inst.logs());
+    }
+    // A step exactly to the stop time, one just past it within the slack, one past it; near
+    // 1 s (the step's slack 1e-6 h counts) and near 1e6 s (the stop's 1e-9 relative, 1e-3 s).
+    for (start, stop, h, ok) in [
+        (0.5, 1.5, 1.0, true),
+        (0.5, 1.5, 1.0 + 1e-7, true),
+        (0.5, 1.5, 1.001, false),
+        (0.5, 1.5, 1.02, false),
+        (at - 1.0, at, 1.0, true),
+        (at - 1.0, at, 1.0005, true),
+        (at - 1.0, at, 1.002, false),
+    ] {
+        let inst = started("stop", start, stop);
+        let status = step(&inst, start, h);
+        assert_eq!(
+            status == OK,
+            ok,
+            "{start} + {h} to {stop}: {:?}",
+            inst.logs()
+        );
+    }
 }
