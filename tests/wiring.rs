@@ -286,3 +286,53 @@ fn do_step_takes_the_hosts_rounding_and_stops_at_the_stop_time() {
         );
     }
 }
+
+/// Motion far beyond the walls is told once, as a warning of fmi2DoStep that names the step's
+/// end and the damper's reason; the next steps are quiet.
+#[test]
+fn implausible_motion_is_a_warning_once() {
+    let mut inst = Instance::new("notice");
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.set_integer(vr::MODEL, 1), OK);
+    assert_eq!(inst.exit(), OK);
+    let (_, w) = fundamental();
+    // A static deflection of 20 m (the tank is 0.25 m long), for a quarter period.
+    assert_eq!(inst.set_real(vr::BASE_A, -20.0 * w * w), OK);
+    let quarter = 0.5 * PI / w;
+    assert_eq!(inst.do_step(quarter), WARNING, "{:?}", inst.logs());
+    let logs = inst.logs();
+    let told: Vec<&String> = logs
+        .iter()
+        .filter(|m| m.contains("implausible"))
+        .collect();
+    assert_eq!(told.len(), 1, "{logs:?}");
+    // 65 g of base acceleration: the reason is the acceleration's.
+    let expected = format!(
+        "fmi2DoStep to t = {quarter}: base.a = {} m/s^2 is 65 g",
+        -20.0 * w * w
+    );
+    assert!(told[0].starts_with(&expected), "{}", told[0]);
+    // The host helper counts time on fmi2OK only.
+    inst.time += quarter;
+    assert_eq!(inst.do_step(0.001), OK, "{:?}", inst.logs());
+}
+
+/// A tolerance given to fmi2SetupExperiment travels with the saved state: the state of such
+/// an instance is serialised, read back and set.
+#[test]
+fn a_state_with_a_tolerance_round_trips() {
+    let mut inst = Instance::new("tolerance-state");
+    let status = unsafe { inst.lib.fmi2SetupExperiment(inst.c, 1, 1e-7, 0.0, 0, 0.0) };
+    assert_eq!(status, OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.exit(), OK);
+    assert_eq!(inst.do_step(0.01), OK);
+    let bytes = inst.serialised();
+    let mut restored = restore(&inst, &bytes);
+    assert_eq!(inst.serialised(), bytes);
+    assert_eq!(
+        unsafe { inst.lib.fmi2FreeFMUstate(inst.c, &mut restored) },
+        OK
+    );
+}
