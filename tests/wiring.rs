@@ -302,10 +302,7 @@ fn implausible_motion_is_a_warning_once() {
     let quarter = 0.5 * PI / w;
     assert_eq!(inst.do_step(quarter), WARNING, "{:?}", inst.logs());
     let logs = inst.logs();
-    let told: Vec<&String> = logs
-        .iter()
-        .filter(|m| m.contains("implausible"))
-        .collect();
+    let told: Vec<&String> = logs.iter().filter(|m| m.contains("implausible")).collect();
     assert_eq!(told.len(), 1, "{logs:?}");
     // 65 g of base acceleration: the reason is the acceleration's.
     let expected = format!(
