@@ -58,7 +58,8 @@ fn surface_per_x() -> f64 {
     -PI * PI * natural(1).0 / (2.0 * RHO * B * A * A)
 }
 
-const OUTPUTS: [Output; 14] = [
+/// Every output of the damper.
+pub(super) const OUTPUTS: [Output; 14] = [
     Output::Force,
     Output::X,
     Output::V,
