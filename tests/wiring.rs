@@ -275,6 +275,9 @@ fn do_step_takes_the_hosts_rounding_and_stops_at_the_stop_time() {
         (at - 1.0, at, 1.0, true),
         (at - 1.0, at, 1.0005, true),
         (at - 1.0, at, 1.002, false),
+        // A short step: its own slack, 1e-6 h, is 1e-8 s.
+        (0.5, 0.51, 0.01, true),
+        (0.5, 0.51, 0.01005, false),
     ] {
         let inst = started("stop", start, stop);
         let status = step(&inst, start, h);
@@ -332,4 +335,26 @@ fn a_state_with_a_tolerance_round_trips() {
         unsafe { inst.lib.fmi2FreeFMUstate(inst.c, &mut restored) },
         OK
     );
+}
+
+/// fmi2SetupExperiment's tolerance is the solver's when the host did not set
+/// solver.tolerance: the same run, to the last bit, as with solver.tolerance set to it.
+#[test]
+fn the_experiments_tolerance_is_the_solvers() {
+    let run = |experiment: bool| {
+        let mut inst = Instance::new("experiment-tolerance");
+        let defined = i32::from(experiment);
+        let status = unsafe {
+            inst.lib
+                .fmi2SetupExperiment(inst.c, defined, 1e-9, 0.0, 0, 0.0)
+        };
+        assert_eq!(status, OK);
+        assert_eq!(inst.enter(), OK);
+        if !experiment {
+            assert_eq!(inst.set_real(vr::SOLVER_TOLERANCE, 1e-9), OK);
+        }
+        assert_eq!(inst.exit(), OK);
+        inst.run_harmonic(100, 0.05)
+    };
+    assert_eq!(run(true).to_bits(), run(false).to_bits());
 }
