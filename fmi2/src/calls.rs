@@ -272,6 +272,51 @@ mod tests {
         }
     }
 
+    /// The whole refusal, for each way out and for none: the states that allow the call,
+    /// listed exactly, and the hint that fits this phase alone.
+    #[test]
+    fn refusals_list_the_allowed_states_and_the_one_way_out() {
+        let cases = [
+            (
+                Phase::InitializationMode,
+                SETUP_EXPERIMENT,
+                "fmi2SetupExperiment is not allowed in state InitializationMode (allowed in: \
+                 Instantiated). That is only possible before initialisation: call fmi2Reset first.",
+            ),
+            (
+                Phase::StepComplete,
+                EXIT_INITIALIZATION_MODE,
+                "fmi2ExitInitializationMode is not allowed in state StepComplete (allowed in: \
+                 InitializationMode).",
+            ),
+            (
+                Phase::Instantiated,
+                TERMINATE,
+                "fmi2Terminate is not allowed in state Instantiated (allowed in: StepComplete). \
+                 Initialise first: fmi2SetupExperiment, fmi2EnterInitializationMode and \
+                 fmi2ExitInitializationMode (again after fmi2Reset).",
+            ),
+            (
+                Phase::Instantiated,
+                GET_REAL_STATUS,
+                "fmi2GetRealStatus is not allowed in state Instantiated (allowed in: \
+                 StepComplete, Terminated). Initialise first: fmi2SetupExperiment, \
+                 fmi2EnterInitializationMode and fmi2ExitInitializationMode (again after \
+                 fmi2Reset).",
+            ),
+            (
+                Phase::Terminated,
+                SET_REAL,
+                "fmi2SetReal is not allowed in state Terminated (allowed in: Instantiated, \
+                 InitializationMode, StepComplete). The instance is terminated: call fmi2Reset \
+                 to start again, or fmi2FreeInstance.",
+            ),
+        ];
+        for (phase, call, expected) in cases {
+            assert_eq!(phase.refusal(&call, "TLD"), expected);
+        }
+    }
+
     /// Only fmi2Reset gets an instance out of an internal error.
     #[test]
     fn a_broken_instance_allows_reset_only() {

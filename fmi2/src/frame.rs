@@ -266,6 +266,47 @@ mod tests {
         assert_eq!(part.finish(), Ok(()));
     }
 
+    /// Every combination of the slave's flag and the experiment's optional bounds comes back as
+    /// it went in; a tolerance that is not positive does not.
+    #[test]
+    fn every_flag_round_trips_alone() {
+        for bits in 0..8u8 {
+            let common = Common {
+                phase: Phase::InitializationMode,
+                experiment: Experiment {
+                    tolerance: (bits & 2 != 0).then_some(1e-4),
+                    start: -1.0,
+                    stop: (bits & 4 != 0).then_some(9.0),
+                },
+                time: 0.0,
+                flag: bits & 1 != 0,
+            };
+            let bytes = encode(TAG, 3, GUID, &common, |_| {});
+            let (read, _) = decode(&bytes, TAG, 3, GUID, "Test").expect("a good frame");
+            assert_eq!(read, common, "flags {bits}");
+        }
+        for tolerance in [0.0, -1e-6] {
+            let (mut common, _) = sample();
+            common.experiment.tolerance = Some(tolerance);
+            let bytes = encode(TAG, 3, GUID, &common, |_| {});
+            assert!(decode(&bytes, TAG, 3, GUID, "Test").is_err(), "{tolerance}");
+        }
+    }
+
+    /// A list that claims more numbers than the rest of the state holds is refused as such
+    /// before it is read, wherever it stands in the state.
+    #[test]
+    fn a_list_longer_than_the_state_is_refused_before_reading() {
+        let (common, _) = sample();
+        let bytes = encode(TAG, 3, GUID, &common, |out| {
+            out.extend_from_slice(&3u32.to_le_bytes());
+            out.extend_from_slice(&[0u8; 16]);
+        });
+        let (_, mut part) = decode(&bytes, TAG, 3, GUID, "Test").expect("a good frame");
+        let why = part.f64_list().expect_err("three numbers in 16 bytes");
+        assert!(why.contains("a list is longer than the buffer"), "{why}");
+    }
+
     /// Every kind of damage is named: tag, version, GUID, checksum, truncation, trailing bytes.
     #[test]
     fn a_damaged_frame_says_what_is_wrong() {

@@ -16,6 +16,9 @@ pub mod nonlinear;
 pub mod shallow_water;
 pub mod slamming;
 
+#[cfg(test)]
+mod wiring_tests;
+
 pub use common::{AmplitudeSource, Common, Derived};
 pub use damper::{Damper, Report};
 pub use parameters::{Parameters, StartValues, choice};
