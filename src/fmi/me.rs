@@ -67,6 +67,25 @@ fn unknown(r: u32) -> Result<Unknown, Refusal> {
     }
 }
 
+/// `values` into the host's `out` if all are finite; else refused, saying which `what` is not.
+fn copy_finite(
+    function: &str,
+    what: &str,
+    context: &Context,
+    a: f64,
+    values: &[f64],
+    out: &mut [f64],
+) -> Reply {
+    if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        return Err(refuse(format!(
+            "{function} at t = {}: {what} {k} is not finite (base.a = {a})",
+            context.time
+        )));
+    }
+    out.copy_from_slice(values);
+    Ok(Status::Ok)
+}
+
 impl Tld {
     fn running(&self, function: &str) -> Result<&Damper, Refusal> {
         self.sim
@@ -134,14 +153,14 @@ impl Continuous for Tld {
         let d = self
             .running("fmi2GetDerivatives")?
             .continuous_derivatives(&inputs);
-        if let Some(k) = d.iter().position(|v| !v.is_finite()) {
-            return Err(refuse(format!(
-                "fmi2GetDerivatives at t = {}: derivative {k} is not finite (base.a = {})",
-                context.time, inputs.a
-            )));
-        }
-        dx.copy_from_slice(&d);
-        Ok(Status::Ok)
+        copy_finite(
+            "fmi2GetDerivatives",
+            "derivative",
+            context,
+            inputs.a,
+            &d,
+            dx,
+        )
     }
 
     fn nominals(&self, out: &mut [f64]) -> Reply {
@@ -172,13 +191,6 @@ impl Continuous for Tld {
         let mut out = vec![0.0; unknowns.len()];
         sim.directional_derivatives(&inputs, &d, &unknowns, &mut out)
             .map_err(|why| refuse(format!("{F}: {why}")))?;
-        if let Some(k) = out.iter().position(|v| !v.is_finite()) {
-            return Err(refuse(format!(
-                "{F} at t = {}: entry {k} is not finite (base.a = {})",
-                context.time, inputs.a
-            )));
-        }
-        dv_unknown.copy_from_slice(&out);
-        Ok(Status::Ok)
+        copy_finite(F, "entry", context, inputs.a, &out, dv_unknown)
     }
 }
