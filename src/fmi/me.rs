@@ -1,14 +1,90 @@
-//! TLD.fmu in Model Exchange: the damper's continuous states, derivatives and nominals through
-//! the shared layer's [`Continuous`] contract. The layer has checked the phase (the simulation
-//! exists), the array lengths (the model description's four states) and that the states are
-//! finite.
+//! TLD.fmu in Model Exchange: the damper's continuous states, derivatives, nominals and
+//! directional derivatives through the shared layer's [`Continuous`] contract. The layer has
+//! checked the phase (the simulation exists), the array lengths (the model description's four
+//! states) and that the states are finite. Value references become the model's states, inputs,
+//! derivatives and outputs here; the model computes J d.
 
 use fmi2_slave::{Context, Continuous, Refusal, Reply, Status, refuse};
 
+use super::params::output_of;
 use super::slave::Tld;
-use super::vars::vr;
-use crate::model::Damper;
-use crate::model::continuous::STATES;
+use super::vars::{VARIABLES, VarType, index_of, vr};
+use crate::model::continuous::{Direction, STATES};
+use crate::model::{Damper, Unknown};
+
+/// The state derivative variables, in state order.
+const DERIVATIVES: [u32; STATES] = [
+    vr::DER_SLOSH_X_,
+    vr::DER_SLOSH_V_,
+    vr::DER_ENERGY_INPUT_,
+    vr::DER_ENERGY_DISSIPATED_,
+];
+
+/// The continuous state variables, in state order.
+const STATE_VARIABLES: [u32; STATES] = [
+    vr::SLOSH_X,
+    vr::SLOSH_V,
+    vr::ENERGY_INPUT,
+    vr::ENERGY_DISSIPATED,
+];
+
+/// The direction the host gives as changes `dv` of the states and inputs `knowns`.
+fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
+    let mut d = Direction::default();
+    for (&r, &change) in knowns.iter().zip(dv) {
+        let slot = match r {
+            vr::BASE_A => &mut d.a,
+            vr::BASE_V => &mut d.v,
+            vr::BASE_X => &mut d.x,
+            _ => match STATE_VARIABLES.iter().position(|&s| s == r) {
+                Some(k) => &mut d.states[k],
+                None => {
+                    return Err(refuse(format!(
+                        "fmi2GetDirectionalDerivative: value reference {r} is neither a \
+                         continuous state (slosh.x, slosh.v, energy.input, energy.dissipated) nor \
+                         an input (base.a, base.v, base.x)"
+                    )));
+                }
+            },
+        };
+        *slot += change;
+    }
+    Ok(d)
+}
+
+/// What the unknown `r` is: a state's derivative or a Real output.
+fn unknown(r: u32) -> Result<Unknown, Refusal> {
+    if let Some(k) = DERIVATIVES.iter().position(|&d| d == r) {
+        return Ok(Unknown::Derivative(k));
+    }
+    let real = index_of(r).is_some_and(|k| VARIABLES[k].ty == VarType::Real);
+    match output_of(r) {
+        Some(which) if real => Ok(Unknown::Output(which)),
+        _ => Err(refuse(format!(
+            "fmi2GetDirectionalDerivative: value reference {r} is neither a state derivative \
+             nor a Real output"
+        ))),
+    }
+}
+
+/// `values` into the host's `out` if all are finite; else refused, saying which `what` is not.
+fn copy_finite(
+    function: &str,
+    what: &str,
+    context: &Context,
+    a: f64,
+    values: &[f64],
+    out: &mut [f64],
+) -> Reply {
+    if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        return Err(refuse(format!(
+            "{function} at t = {}: {what} {k} is not finite (base.a = {a})",
+            context.time
+        )));
+    }
+    out.copy_from_slice(values);
+    Ok(Status::Ok)
+}
 
 impl Tld {
     fn running(&self, function: &str) -> Result<&Damper, Refusal> {
@@ -25,14 +101,7 @@ impl Tld {
         context: &Context,
         r: u32,
     ) -> Option<Result<f64, Refusal>> {
-        let k = [
-            vr::DER_SLOSH_X_,
-            vr::DER_SLOSH_V_,
-            vr::DER_ENERGY_INPUT_,
-            vr::DER_ENERGY_DISSIPATED_,
-        ]
-        .iter()
-        .position(|&d| d == r)?;
+        let k = DERIVATIVES.iter().position(|&d| d == r)?;
         // Before initialisation (hosts read the initial unknowns in initialisation mode): from
         // the simulation the parameters set so far would start.
         let mut provisional = None;
@@ -84,14 +153,14 @@ impl Continuous for Tld {
         let d = self
             .running("fmi2GetDerivatives")?
             .continuous_derivatives(&inputs);
-        if let Some(k) = d.iter().position(|v| !v.is_finite()) {
-            return Err(refuse(format!(
-                "fmi2GetDerivatives at t = {}: derivative {k} is not finite (base.a = {})",
-                context.time, inputs.a
-            )));
-        }
-        dx.copy_from_slice(&d);
-        Ok(Status::Ok)
+        copy_finite(
+            "fmi2GetDerivatives",
+            "derivative",
+            context,
+            inputs.a,
+            &d,
+            dx,
+        )
     }
 
     fn nominals(&self, out: &mut [f64]) -> Reply {
@@ -101,5 +170,27 @@ impl Continuous for Tld {
                 .continuous_nominals(),
         );
         Ok(Status::Ok)
+    }
+
+    fn directional_derivative(
+        &self,
+        context: &Context,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Reply {
+        const F: &str = "fmi2GetDirectionalDerivative";
+        let sim = self.running(F)?;
+        let d = direction(knowns, dv_known)?;
+        let unknowns = unknowns
+            .iter()
+            .map(|&r| unknown(r))
+            .collect::<Result<Vec<_>, _>>()?;
+        let inputs = self.values.inputs([0.0; 2]);
+        let mut out = vec![0.0; unknowns.len()];
+        sim.directional_derivatives(&inputs, &d, &unknowns, &mut out)
+            .map_err(|why| refuse(format!("{F}: {why}")))?;
+        copy_finite(F, "entry", context, inputs.a, &out, dv_unknown)
     }
 }

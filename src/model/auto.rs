@@ -71,6 +71,13 @@ fn linear_step(
     }))
 }
 
+impl NonlinearAuto {
+    /// The nonlinear model's oscillator (Model Exchange integrates its equations).
+    pub(super) fn oscillator(&self) -> super::rates::Oscillator {
+        self.nonlinear.oscillator()
+    }
+}
+
 impl Model for NonlinearAuto {
     fn configure(p: &dyn Parameters, common: &Common, start: Start) -> Result<Self, String> {
         let nonlinear = Nonlinear::configure(p, common, start)?;

@@ -11,8 +11,14 @@
 //! states is fixed, while swe.cells is a parameter). A Linear model of more than one mode
 //! would need more states than the model description declares.
 //!
+//! Directional derivatives (J d, for a host's implicit solver): the exact derivatives of the
+//! same rates in the states and the base acceleration, the damping ratio fixed (amplitude =
+//! Fixed), from the oscillator's restoring force f(x) and its slope f'(x) (Phi of Eq 2.13 and
+//! dPhi/dx; finite at x = 0 for every eta >= 1).
+//!
 //! [`Model::rate`]: super::Model::rate
 
+use super::rates::{Change, Oscillator};
 use super::registry::AnyModel;
 use super::{Observable, Output};
 
@@ -32,7 +38,63 @@ pub const RATES: [Output; STATES] = [
 /// `y`); the tests check it for each.
 const OSCILLATOR: usize = 4;
 
+/// A direction d in the continuous states and the inputs.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Direction {
+    /// Changes of [x, v, energy.input, energy.dissipated].
+    pub states: [f64; STATES],
+    /// Changes of the inputs base.a [m/s^2], base.v [m/s], base.x [m]. With amplitude = Fixed
+    /// no equation reads base.v or base.x: their columns of J are 0.
+    pub a: f64,
+    pub v: f64,
+    pub x: f64,
+}
+
+/// J d of the offered models' continuous part.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tangent {
+    /// Of the states' derivatives, in state order.
+    pub derivatives: [f64; STATES],
+    /// Of the force on the tanks [N] and of the stored energy [J].
+    pub force: f64,
+    pub stored: f64,
+}
+
 impl AnyModel {
+    /// The model's one oscillator, if it is one of those offered in Model Exchange.
+    fn oscillator(&self) -> Option<Oscillator> {
+        match self {
+            AnyModel::Linear(m) => match m.modes() {
+                [only] => Some(only.oscillator()),
+                _ => None,
+            },
+            AnyModel::Nonlinear(m) => Some(m.oscillator()),
+            AnyModel::Auto(m) => Some(m.oscillator()),
+            AnyModel::SloshingSlamming(_) | AnyModel::ShallowWater(_) => None,
+        }
+    }
+
+    /// J d under base acceleration `a`: the exact change of the states' derivatives, the force
+    /// and the stored energy for the direction `d`. Err for a model not offered in Model
+    /// Exchange.
+    pub fn continuous_tangent(&self, a: f64, d: &Direction) -> Result<Tangent, String> {
+        self.offers_model_exchange()?;
+        let o = self
+            .oscillator()
+            .ok_or("this model has no directional derivatives")?;
+        let change = Change {
+            dx: d.states[0],
+            dv: d.states[1],
+            da: d.a,
+        };
+        // The energies' derivatives do not read the energies: their columns are 0.
+        Ok(Tangent {
+            derivatives: RATES.map(|which| o.rate_tangent(which, a, change).unwrap_or(0.0)),
+            force: o.force_tangent(change),
+            stored: o.stored_tangent(change),
+        })
+    }
+
     /// Ok if the host's solver can integrate this model; Err: why not.
     pub fn offers_model_exchange(&self) -> Result<(), String> {
         match self {
@@ -144,5 +206,19 @@ mod tests {
         assert!(why(model(ModelKindItem::Linear, 3.0)).contains("modes = 1"));
         assert!(why(model(ModelKindItem::SloshingSlamming, 1.0)).contains("state events"));
         assert!(why(model(ModelKindItem::ShallowWater, 1.0)).contains("swe.cells"));
+    }
+
+    /// Nor have they a Jacobian: refused with the same reason, never numbers.
+    #[test]
+    fn models_not_offered_have_no_tangent() {
+        for (item, modes) in [
+            (ModelKindItem::Linear, 3.0),
+            (ModelKindItem::SloshingSlamming, 1.0),
+            (ModelKindItem::ShallowWater, 1.0),
+        ] {
+            let m = model(item, modes);
+            let got = m.continuous_tangent(0.1, &Direction::default());
+            assert_eq!(got.err(), m.offers_model_exchange().err(), "{item:?}");
+        }
     }
 }

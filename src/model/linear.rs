@@ -78,6 +78,13 @@ pub struct Linear {
     sloshing_mass: f64,
 }
 
+impl Linear {
+    /// The modes, the fundamental first.
+    pub(super) fn modes(&self) -> &[LinearMode] {
+        &self.modes
+    }
+}
+
 impl Model for Linear {
     fn configure(p: &dyn Parameters, common: &Common, start: Start) -> Result<Self, String> {
         let modes = p.count(vr::MODES);

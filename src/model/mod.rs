@@ -20,7 +20,7 @@ pub mod slamming;
 mod wiring_tests;
 
 pub use common::{AmplitudeSource, Common, Derived};
-pub use damper::{Damper, Report};
+pub use damper::{Damper, Report, Unknown};
 pub use parameters::{Parameters, StartValues, choice};
 pub use registry::AnyModel;
 

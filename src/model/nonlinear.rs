@@ -355,6 +355,20 @@ impl Nonlinear {
     }
 }
 
+impl Nonlinear {
+    /// The sloshing mass as an oscillator now: Phi of Eq 2.13 and its slope at x.
+    pub(super) fn oscillator(&self) -> Oscillator {
+        let (x, v) = self.sloshing();
+        Oscillator {
+            mass: self.mass,
+            v,
+            c: self.tld.c,
+            restoring: self.tld.stiffness.force(x),
+            slope: self.tld.stiffness.slope(x),
+        }
+    }
+}
+
 impl Model for Nonlinear {
     fn configure(p: &dyn Parameters, common: &Common, start: Start) -> Result<Self, String> {
         let fundamental = common.tank.fundamental();
@@ -412,15 +426,7 @@ impl Model for Nonlinear {
     }
 
     fn rate(&self, which: Output, a: f64, _a_rate: f64) -> f64 {
-        let (x, v) = self.sloshing();
-        let oscillator = Oscillator {
-            mass: self.mass,
-            v,
-            c: self.tld.c,
-            restoring: self.tld.stiffness.force(x),
-            slope: self.tld.stiffness.slope(x),
-        };
-        rates::rate(which, &[oscillator], &[], a)
+        rates::rate(which, &[self.oscillator()], &[], a)
     }
 
     fn set_damping(&mut self, zeta: f64) {

@@ -14,10 +14,48 @@ pub struct Oscillator {
     pub slope: f64,
 }
 
+/// A change of one oscillator's state, displacement `dx` and velocity `dv`, and of the base
+/// acceleration `da`: the direction d of a directional derivative J d.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Change {
+    pub dx: f64,
+    pub dv: f64,
+    pub da: f64,
+}
+
 impl Oscillator {
     /// x'' under base acceleration `a`.
     fn acceleration(&self, a: f64) -> f64 {
         -a - self.c * self.v - self.restoring
+    }
+
+    /// J d of [`rate`] for this oscillator alone (the fundamental one, no free masses) under
+    /// base acceleration `a`, with the damping c fixed: the exact change of the rates of x, v
+    /// and of the two energies for the change `d`. f(x) enters through its slope f'(x) only.
+    /// None for the outputs whose rate is not a state's derivative.
+    pub fn rate_tangent(&self, which: Output, a: f64, d: Change) -> Option<f64> {
+        let (m, c, v) = (self.mass, self.c, self.v);
+        // d(x'') = -da - c dv - f'(x) dx.
+        let acceleration = -d.da - c * d.dv - self.slope * d.dx;
+        Some(match which {
+            Output::X => d.dv,
+            Output::V => acceleration,
+            // d(-m a v) = -m (a dv + v da).
+            Output::EnergyInput => -m * (a * d.dv + v * d.da),
+            // d(m c v^2) = 2 m c v dv.
+            Output::EnergyDissipated => 2.0 * m * c * v * d.dv,
+            _ => return None,
+        })
+    }
+
+    /// J d of the force on the tank m (c v + f(x)): m (c dv + f'(x) dx).
+    pub fn force_tangent(&self, d: Change) -> f64 {
+        self.mass * (self.c * d.dv + self.slope * d.dx)
+    }
+
+    /// J d of the stored energy m (v^2/2 + U(x)), U' = f: m (v dv + f(x) dx).
+    pub fn stored_tangent(&self, d: Change) -> f64 {
+        self.mass * (self.v * d.dv + self.restoring * d.dx)
     }
 }
 

@@ -5,8 +5,15 @@
 //! host's solver has none; it is refused with that reason.
 
 use super::{Damper, per_step};
-use crate::model::continuous::STATES;
-use crate::model::{AmplitudeSource, Inputs};
+use crate::model::continuous::{Direction, STATES};
+use crate::model::{AmplitudeSource, Inputs, Output};
+
+/// What a directional derivative asks for: a state's derivative (in state order) or an output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unknown {
+    Derivative(usize),
+    Output(Output),
+}
 
 impl Damper {
     /// Ok if a host's solver can integrate this damper; Err: why not.
@@ -57,5 +64,68 @@ impl Damper {
         let v = self.derived.omega_f * x;
         let energy = (0.5 * self.derived.mass_slosh * v * v).max(f64::MIN_POSITIVE);
         [x, v, energy, energy]
+    }
+
+    /// J d: the exact change of each of `unknowns` for the change `d` of the states and inputs
+    /// (amplitude = Fixed, so the damping ratio does not change with them), into `out`. Err, and
+    /// `out` untouched, for a damper not offered in Model Exchange or an unknown out of range.
+    pub fn directional_derivatives(
+        &self,
+        inputs: &Inputs,
+        d: &Direction,
+        unknowns: &[Unknown],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        self.offers_model_exchange()?;
+        let t = self.model.continuous_tangent(inputs.a, d)?;
+        let mut values = Vec::with_capacity(unknowns.len());
+        for &unknown in unknowns {
+            values.push(match unknown {
+                Unknown::Derivative(k) => *t.derivatives.get(k).ok_or_else(|| {
+                    format!("there are {STATES} state derivatives, not {}", k + 1)
+                })?,
+                Unknown::Output(which) => self.output_tangent(which, d, t.force, t.stored)?,
+            });
+        }
+        out.copy_from_slice(&values);
+        Ok(())
+    }
+
+    /// J d of the output `which` (as [`Damper::output`] forms it), given the force's and the
+    /// stored energy's.
+    fn output_tangent(
+        &self,
+        which: Output,
+        d: &Direction,
+        force: f64,
+        stored: f64,
+    ) -> Result<f64, String> {
+        Ok(match which {
+            Output::X => d.states[0],
+            Output::V => d.states[1],
+            Output::Force => force,
+            // Until a step has been taken (none is in Model Exchange) the mean force is the force.
+            Output::ForceMean => {
+                if self.last_mean_force.is_some() {
+                    0.0
+                } else {
+                    force
+                }
+            }
+            Output::BaseShear => {
+                force - (self.derived.mass_inactive + self.model.rigid_mass()) * d.a
+            }
+            Output::EnergyInput => d.states[2],
+            Output::EnergyDissipated => d.states[3],
+            Output::EnergyStored => stored,
+            // Fixed amplitude and damping; no impacts in the offered models.
+            Output::Amplitude | Output::Zeta | Output::ImpactZ | Output::Impacts => 0.0,
+            Output::SurfaceLeft | Output::SurfaceRight => {
+                if self.model.surface().is_some() {
+                    return Err(format!("{which:?} of a model that resolves the surface"));
+                }
+                self.mode_surface(usize::from(which == Output::SurfaceRight)) * d.states[0]
+            }
+        })
     }
 }
