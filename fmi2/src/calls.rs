@@ -292,8 +292,8 @@ mod tests {
             (
                 Phase::Instantiated,
                 TERMINATE,
-                "fmi2Terminate is not allowed in state Instantiated (allowed in: StepComplete). \
-                 Initialise first: fmi2SetupExperiment, fmi2EnterInitializationMode and \
+                "fmi2Terminate is not allowed in state Instantiated (allowed in: StepComplete, \
+                 EventMode, ContinuousTimeMode). Initialise first: fmi2SetupExperiment, fmi2EnterInitializationMode and \
                  fmi2ExitInitializationMode (again after fmi2Reset).",
             ),
             (
@@ -308,7 +308,7 @@ mod tests {
                 Phase::Terminated,
                 SET_REAL,
                 "fmi2SetReal is not allowed in state Terminated (allowed in: Instantiated, \
-                 InitializationMode, StepComplete). The instance is terminated: call fmi2Reset \
+                 InitializationMode, StepComplete, EventMode, ContinuousTimeMode). The instance is terminated: call fmi2Reset \
                  to start again, or fmi2FreeInstance.",
             ),
         ];
