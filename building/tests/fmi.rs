@@ -444,3 +444,29 @@ fn calculated_parameters_are_the_modes_and_their_damping() {
     assert!(close(w1, w) && w2 == w1, "{w1} {w2}");
     assert!(close(alpha / (2.0 * w), zeta / 2.0) && close(beta * w / 2.0, zeta / 2.0));
 }
+
+/// Output derivatives of anything but an output are refused, naming it: an input, a parameter,
+/// a Model Exchange local (floor[1].v, whose value reference lies above the outputs').
+#[test]
+fn output_derivatives_of_non_outputs_are_refused() {
+    let inst = Instance::new("not-outputs");
+    inst.initialise(&ONE_STOREY);
+    for (r, name) in [
+        (vr::GROUND_A, "ground.a"),
+        (vr::STOREY_1__MASS, "storey[1].mass"),
+        (vr::FLOOR_1__V, "floor[1].v"),
+    ] {
+        let (mut v, order) = (f64::NAN, 1);
+        // SAFETY: our live instance, one value reference, order and value each.
+        let s = unsafe {
+            inst.lib
+                .fmi2GetRealOutputDerivatives(inst.c, &r, 1, &order, &mut v)
+        };
+        assert_eq!(s, ERROR, "{name}");
+        let said = inst.logs();
+        assert_eq!(
+            said.last().map(String::as_str),
+            Some(format!("fmi2GetRealOutputDerivatives: '{name}' is not an output").as_str())
+        );
+    }
+}
