@@ -2,6 +2,7 @@
 //! leaves the slave contract's defaults (`Slave::tolerance`, `Slave::notice`) as they are:
 //! neither FMU of the workspace panics through its entry points, and TLD overrides both defaults.
 
+use std::collections::BTreeMap;
 use std::ffi::CString;
 use std::sync::{Mutex, Once};
 
@@ -39,6 +40,16 @@ static TABLE: Table = Table {
 
 impl Continuous for Testy {}
 
+/// Testy's get and set: it has no variables, so only an empty list is carried out.
+fn no_variables(vrs: &[u32], function: &str) -> Reply {
+    match vrs {
+        [] => Ok(Status::Ok),
+        [r, ..] => Err(refuse(format!(
+            "{function}: no variable has value reference {r}"
+        ))),
+    }
+}
+
 impl Slave for Testy {
     const TABLE: &'static Table = &TABLE;
     const MARK: u64 = 0x5445_5354_5953_4c56;
@@ -70,11 +81,7 @@ impl Slave for Testy {
         f: &str,
         _: fn(f64) -> T,
     ) -> Reply {
-        if vrs.is_empty() {
-            Ok(Status::Ok)
-        } else {
-            Err(refuse(format!("{f}: no variables")))
-        }
+        no_variables(vrs, f)
     }
     fn set<T: Copy>(
         &mut self,
@@ -85,11 +92,7 @@ impl Slave for Testy {
         f: &str,
         _: fn(T) -> f64,
     ) -> Reply {
-        if vrs.is_empty() {
-            Ok(Status::Ok)
-        } else {
-            Err(refuse(format!("{f}: no variables")))
-        }
+        no_variables(vrs, f)
     }
     fn set_input_derivatives(&mut self, _: &[u32], _: &[i32], _: &[f64]) -> Reply {
         Err(refuse("no inputs"))
@@ -121,9 +124,10 @@ mod c {
     pub(super) use fmi2_exports::fmi2DoStep;
 }
 
-/// Log records of every instance: (instance name, level, message).
-static RECORDS: Mutex<Vec<(String, log::Level, String)>> = Mutex::new(Vec::new());
+/// What each instance logged, by instance name: (level, message).
+static RECORDS: Mutex<BTreeMap<String, Vec<(log::Level, String)>>> = Mutex::new(BTreeMap::new());
 
+/// The host's log, as fmi-sys's C logger hands the messages to the `log` crate.
 struct Capture;
 
 impl log::Log for Capture {
@@ -131,11 +135,12 @@ impl log::Log for Capture {
         true
     }
     fn log(&self, record: &log::Record) {
-        RECORDS.lock().unwrap().push((
-            record.target().to_string(),
-            record.level(),
-            record.args().to_string(),
-        ));
+        let said = (record.level(), record.args().to_string());
+        let mut records = RECORDS.lock().unwrap();
+        records
+            .entry(record.target().into())
+            .or_default()
+            .push(said);
     }
     fn flush(&self) {}
 }
@@ -143,11 +148,7 @@ impl log::Log for Capture {
 /// The messages logged so far for the instance `name`, with their levels.
 pub(super) fn logs_of(name: &str) -> Vec<(log::Level, String)> {
     let records = RECORDS.lock().unwrap();
-    records
-        .iter()
-        .filter(|(n, _, _)| n == name)
-        .map(|(_, l, m)| (*l, m.clone()))
-        .collect()
+    records.get(name).cloned().unwrap_or_default()
 }
 
 /// An instance of Testy, named `name` (each test its own), logging through fmi-sys's C logger
