@@ -15,12 +15,14 @@ use crate::frame::Reader;
 use crate::slave::Context;
 use crate::status::refuse;
 
-/// A slave with no variables: it counts its steps, takes a step of `PANIC_STEP` s for a bug
+/// A slave with one variable, a Boolean at value reference 0 (its own: not in the table, which
+/// the shared layer leaves to the slave): it counts its steps, takes a step of `PANIC_STEP` s for a bug
 /// (it panics), and one of `NOTICE_STEP` s for a step with a notice (which it leaves to the
 /// default `notice`). It keeps the experiment's tolerance as `initialise` sees it.
 pub(super) struct Testy {
     steps: u32,
     pub(super) tolerance: Option<f64>,
+    flag: f64,
 }
 
 pub(super) const PANIC_STEP: f64 = 13.0;
@@ -40,13 +42,12 @@ static TABLE: Table = Table {
 
 impl Continuous for Testy {}
 
-/// Testy's get and set: it has no variables, so only an empty list is carried out.
-fn no_variables(vrs: &[u32], function: &str) -> Reply {
-    match vrs {
-        [] => Ok(Status::Ok),
-        [r, ..] => Err(refuse(format!(
-            "{function}: no variable has value reference {r}"
-        ))),
+/// Testy's get and set: only its Boolean, value reference 0.
+fn flag_only(vrs: &[u32], ty: VarType, function: &str) -> Result<(), Refusal> {
+    match vrs.iter().find(|&&r| r != 0) {
+        None if ty == VarType::Boolean || vrs.is_empty() => Ok(()),
+        None => Err(refuse(format!("{function}: the variable is a Boolean"))),
+        Some(r) => Err(refuse(format!("{function}: no variable {r}"))),
     }
 }
 
@@ -60,6 +61,7 @@ impl Slave for Testy {
         Testy {
             steps: 0,
             tolerance: None,
+            flag: 0.0,
         }
     }
     fn initialise(&mut self, context: &Context) -> Result<Vec<String>, Refusal> {
@@ -76,23 +78,29 @@ impl Slave for Testy {
         &self,
         _: &Context,
         vrs: &[u32],
-        _: &mut [T],
-        _: VarType,
+        out: &mut [T],
+        ty: VarType,
         f: &str,
-        _: fn(f64) -> T,
+        to: fn(f64) -> T,
     ) -> Reply {
-        no_variables(vrs, f)
+        flag_only(vrs, ty, f)?;
+        out.iter_mut().for_each(|slot| *slot = to(self.flag));
+        Ok(Status::Ok)
     }
     fn set<T: Copy>(
         &mut self,
         _: &Context,
         vrs: &[u32],
-        _: &[T],
-        _: VarType,
+        values: &[T],
+        ty: VarType,
         f: &str,
-        _: fn(T) -> f64,
+        from: fn(T) -> f64,
     ) -> Reply {
-        no_variables(vrs, f)
+        flag_only(vrs, ty, f)?;
+        if let Some(&v) = values.last() {
+            self.flag = from(v);
+        }
+        Ok(Status::Ok)
     }
     fn set_input_derivatives(&mut self, _: &[u32], _: &[i32], _: &[f64]) -> Reply {
         Err(refuse("no inputs"))
@@ -113,6 +121,7 @@ impl Slave for Testy {
         Ok(Testy {
             steps: part.u32()?,
             tolerance: None,
+            flag: 0.0,
         })
     }
 }
@@ -297,4 +306,28 @@ fn the_slave_defaults_keep_the_tolerance_and_say_nothing() {
     assert_eq!(host.instance().slave.steps, 1);
     assert_eq!(host.instance().context.time, NOTICE_STEP);
     assert_eq!(logs_of(name), []);
+}
+
+/// fmi2SetBoolean and fmi2GetBoolean convert as FMI 2.0 says: fmi2False is 0, any other value
+/// true, read back as fmi2True (1).
+#[test]
+fn booleans_travel_as_fmi2_true_and_false() {
+    let host = Host::new("booleans", None);
+    let r: fmi2ValueReference = 0;
+    for (set, want) in [(0, 0), (1, 1), (0, 0), (7, 1), (-1, 1)] {
+        let mut got: fmi2Boolean = 42;
+        // SAFETY: our live instance; one value reference and one value each.
+        unsafe {
+            assert_eq!(
+                fmi2SetBoolean::<Testy>(host.c, &r, 1, &set),
+                fmi2Status_fmi2OK
+            );
+            assert_eq!(
+                fmi2GetBoolean::<Testy>(host.c, &r, 1, &mut got),
+                fmi2Status_fmi2OK
+            );
+        }
+        assert_eq!(got, want, "set {set}");
+    }
+    assert_eq!(logs_of("booleans"), []);
 }
