@@ -162,7 +162,20 @@ fn output_derivatives_are_the_outputs_slopes() {
         inst.do_step(0.01);
     }
     let (slope, force_rate, dt) = (0.3, 40.0, 1e-5);
-    let outputs = [vr::TLD_A, vr::TLD_V, vr::TLD_X, vr::ROOF_X, vr::BASE_SHEAR];
+    // Every output: the damper's floor (3) and the floors below it too.
+    let outputs = [
+        vr::TLD_A,
+        vr::TLD_V,
+        vr::TLD_X,
+        vr::ROOF_X,
+        vr::BASE_SHEAR,
+        vr::FLOOR_1__X,
+        vr::FLOOR_1__X + 1,
+        vr::FLOOR_1__X + 2,
+        vr::FLOOR_1__A,
+        vr::FLOOR_1__A + 1,
+        vr::FLOOR_1__A + 2,
+    ];
     let sample = |inst: &mut Instance, k: f64| {
         inst.set_real(vr::GROUND_A, slope * k * dt);
         inst.set_real(vr::TLD_FORCE, force_rate * k * dt);
@@ -183,6 +196,55 @@ fn output_derivatives_are_the_outputs_slopes() {
             outputs[k],
             rates[k]
         );
+    }
+    // Floor 4 of three storeys: no floor, standing still (docs/MODEL_EXCHANGE.md: the storeys
+    // above `storeys` stay 0), and so are the last of the twenty.
+    for r in [
+        vr::FLOOR_1__X + 3,
+        vr::FLOOR_1__A + 3,
+        vr::FLOOR_1__X + 19,
+        vr::FLOOR_1__A + 19,
+    ] {
+        assert_eq!((inst.real(r), inst.rate(r)), (0.0, 0.0), "output {r}");
+    }
+}
+
+/// A floor's external force acts where the damper's force acts when the damper stands on that
+/// floor: floor[k].force alone and tld.force alone with tld.floor = k move the building alike,
+/// for each floor k of three storeys.
+#[test]
+fn a_floors_force_acts_on_that_floor() {
+    let (f0, h) = (30.0, 0.02);
+    let run = |params: &[(u32, f64)], force: u32, name: &str| {
+        let mut inst = Instance::new(name);
+        inst.initialise(params);
+        assert_eq!(inst.set_real(force, f0), OK);
+        for _ in 0..25 {
+            assert_eq!(inst.do_step(h), OK);
+        }
+        [
+            vr::FLOOR_1__X,
+            vr::FLOOR_1__X + 1,
+            vr::FLOOR_1__X + 2,
+            vr::FLOOR_1__A + 1,
+        ]
+        .map(|r| inst.real(r))
+    };
+    for k in 1..=3 {
+        let mut on_floor = three_storeys();
+        on_floor.push((vr::TLD_FLOOR, f64::from(k)));
+        let by_damper = run(&on_floor, vr::TLD_FORCE, &format!("damper{k}"));
+        let by_floor = run(&on_floor, vr::FLOOR_1__FORCE + k - 1, &format!("floor{k}"));
+        assert!(
+            by_damper[0].abs() > 1e-6,
+            "the run must move: {by_damper:?}"
+        );
+        for (d, f) in by_damper.iter().zip(&by_floor) {
+            assert!(
+                (d - f).abs() <= 1e-12 * d.abs().max(1e-9),
+                "floor {k}: {by_damper:?} vs {by_floor:?}"
+            );
+        }
     }
 }
 
@@ -328,5 +390,83 @@ fn one_storey_built_in_ground_motion_is_the_closed_form() {
             outputs[j], peak[j]
         );
         assert!(rel < 1e-11, "output {}: {rel:e} of its peak", outputs[j]);
+    }
+}
+
+/// The calculated parameters against their definitions: two equal storeys (mass m, stiffness
+/// k) have omega^2 = (3 -/+ sqrt 5)/2 k/m, and the Rayleigh coefficients give each of the
+/// first two modes its own ratio, zeta_i = alpha/(2 omega_i) + beta omega_i/2; one storey has
+/// one mode (reported for both) damped half by the mass, half by the stiffness.
+#[test]
+fn calculated_parameters_are_the_modes_and_their_damping() {
+    let (m, k, z1, z2) = (80.0_f64, 9000.0_f64, 0.02, 0.05);
+    let calculated = |params: &[(u32, f64)], name: &str| {
+        let inst = Instance::new(name);
+        inst.initialise(params);
+        [
+            vr::MODE_1__OMEGA,
+            vr::MODE_2__OMEGA,
+            vr::DAMPING_ALPHA,
+            vr::DAMPING_BETA,
+        ]
+        .map(|r| inst.real(r))
+    };
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+    let [w1, w2, alpha, beta] = calculated(
+        &[
+            (vr::STOREYS, 2.0),
+            (vr::STOREY_1__MASS, m),
+            (vr::STOREY_1__MASS + 1, m),
+            (vr::STOREY_1__STIFFNESS, k),
+            (vr::STOREY_1__STIFFNESS + 1, k),
+            (vr::DAMPING_ZETA1, z1),
+            (vr::DAMPING_ZETA2, z2),
+        ],
+        "calculated2",
+    );
+    let root5 = 5.0_f64.sqrt();
+    assert!(close(w1, ((3.0 - root5) / 2.0 * k / m).sqrt()), "{w1}");
+    assert!(close(w2, ((3.0 + root5) / 2.0 * k / m).sqrt()), "{w2}");
+    assert!(
+        close(alpha / (2.0 * w1) + beta * w1 / 2.0, z1),
+        "{alpha} {beta}"
+    );
+    assert!(
+        close(alpha / (2.0 * w2) + beta * w2 / 2.0, z2),
+        "{alpha} {beta}"
+    );
+
+    let (m, k, zeta) = (168.0_f64, 5342.0_f64, 0.03);
+    let mut params = ONE_STOREY.to_vec();
+    params.push((vr::DAMPING_ZETA, zeta));
+    let [w1, w2, alpha, beta] = calculated(&params, "calculated1");
+    let w = (k / m).sqrt();
+    assert!(close(w1, w) && w2 == w1, "{w1} {w2}");
+    assert!(close(alpha / (2.0 * w), zeta / 2.0) && close(beta * w / 2.0, zeta / 2.0));
+}
+
+/// Output derivatives of anything but an output are refused, naming it: an input, a parameter,
+/// a Model Exchange local (floor[1].v, whose value reference lies above the outputs').
+#[test]
+fn output_derivatives_of_non_outputs_are_refused() {
+    let inst = Instance::new("not-outputs");
+    inst.initialise(&ONE_STOREY);
+    for (r, name) in [
+        (vr::GROUND_A, "ground.a"),
+        (vr::STOREY_1__MASS, "storey[1].mass"),
+        (vr::FLOOR_1__V, "floor[1].v"),
+    ] {
+        let (mut v, order) = (f64::NAN, 1);
+        // SAFETY: our live instance, one value reference, order and value each.
+        let s = unsafe {
+            inst.lib
+                .fmi2GetRealOutputDerivatives(inst.c, &r, 1, &order, &mut v)
+        };
+        assert_eq!(s, ERROR, "{name}");
+        let said = inst.logs();
+        assert_eq!(
+            said.last().map(String::as_str),
+            Some(format!("fmi2GetRealOutputDerivatives: '{name}' is not an output").as_str())
+        );
     }
 }

@@ -151,3 +151,79 @@ fn directional_derivatives_are_the_linear_system_s() {
             .contains("neither a continuous state nor an input")
     );
 }
+
+/// The inputs drive the derivatives through B: from the same state, tld.force F on the
+/// damper's floor (3) adds F/(m_3 + tld.mass) to floor[3].v's derivative and nothing to the
+/// others; ground.a adds -a_g to every floor's relative acceleration and a_g to ground.v's. The locals ground.x,
+/// ground.v, ground.motion.x and .v read the state's last four entries.
+#[test]
+fn inputs_enter_the_derivatives_and_the_ground_locals_read_the_state() {
+    let inst = running("me-inputs");
+    let x = some_state();
+    assert_eq!(inst.set_states(&x), OK);
+    for k in 0..4 {
+        assert_eq!(
+            inst.real(vr::GROUND_X + k),
+            x[40 + k as usize],
+            "ground local {k}"
+        );
+    }
+    let (_, d0) = inst.derivatives(N);
+    let (force, ag) = (12.0, 0.7);
+    let m3 = inst.real(vr::STOREY_1__MASS + 2) + 0.35;
+    assert_eq!(inst.set_real(vr::TLD_FORCE, force), OK);
+    let (_, d1) = inst.derivatives(N);
+    assert_eq!(inst.set_real(vr::TLD_FORCE, 0.0), OK);
+    assert_eq!(inst.set_real(vr::GROUND_A, ag), OK);
+    let (_, d2) = inst.derivatives(N);
+    for k in 0..N {
+        let by_force = if k == 22 { force / m3 } else { 0.0 };
+        let by_ground = match k {
+            20..23 => -ag,
+            41 => ag, // ground.v integrates ground.a
+            _ => 0.0,
+        };
+        assert!(
+            (d1[k] - d0[k] - by_force).abs() < 1e-12,
+            "tld.force, {k}: {} {}",
+            d1[k],
+            d0[k]
+        );
+        assert!(
+            (d2[k] - d0[k] - by_ground).abs() < 1e-12,
+            "ground.a, {k}: {} {}",
+            d2[k],
+            d0[k]
+        );
+    }
+}
+
+/// The nominals (MODEL_EXCHANGE.md): floors' displacements the first storey's static drift
+/// under 1 g of the building's mass, m g / k_1, velocities that times omega_1 = sqrt(k_1 / m)
+/// (one storey, stiff enough that neither is clamped to 1), the ground's 1.
+#[test]
+fn nominals_are_the_static_drift_and_its_velocity() {
+    let (m, k) = (168.0_f64, 53420.0_f64);
+    let inst = Instance::model_exchange("me-nominals");
+    inst.initialise(&[
+        (vr::STOREYS, 1.0),
+        (vr::STOREY_1__MASS, m),
+        (vr::STOREY_1__STIFFNESS, k),
+    ]);
+    let (s, nominal) = inst.nominals(N);
+    assert_eq!(s, OK);
+    let x = m * 9.81 / k;
+    let v = x * (k / m).sqrt();
+    assert!(v < 1.0);
+    for (j, got) in nominal.iter().enumerate() {
+        let want = match j {
+            0..20 => x,
+            20..40 => v,
+            _ => 1.0,
+        };
+        assert!(
+            (got - want).abs() <= 1e-12 * want,
+            "nominal {j}: {got} vs {want}"
+        );
+    }
+}

@@ -437,3 +437,93 @@ impl Slave for Building {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fmi2_slave::calls::Phase;
+    use fmi2_slave::frame::{self, Common, Experiment};
+
+    fn context(phase: Phase) -> Context {
+        Context {
+            phase,
+            experiment: Experiment::default(),
+            time: 0.0,
+        }
+    }
+
+    /// A Building from a framed state whose slave part `payload` writes (the frame and its
+    /// checksum sound, so only `load` judges the payload).
+    fn load(phase: Phase, payload: impl FnOnce(&mut Vec<u8>)) -> Result<Building, String> {
+        let common = Common {
+            phase,
+            experiment: Experiment::default(),
+            time: 0.0,
+            flag: false,
+        };
+        let (tag, version) = (Building::STATE_TAG, Building::STATE_VERSION);
+        let bytes = frame::encode(&tag, version, TABLE.guid, &common, payload);
+        let (common, mut part) = frame::decode(&bytes, &tag, version, TABLE.guid, "Building")?;
+        Building::load(&context(common.phase), common.flag, &mut part)
+    }
+
+    fn payload(lists: &[Vec<f64>; 3]) -> Vec<u8> {
+        let mut out = Vec::new();
+        lists.iter().for_each(|l| put_f64_list(&mut out, l));
+        out
+    }
+
+    /// A saved state's three lists, each one entry short or long alone, are refused; the
+    /// lists as saved load.
+    #[test]
+    fn a_state_whose_lists_do_not_fit_is_refused() {
+        let mut b = <Building as Slave>::new();
+        b.initialise(&context(Phase::InitializationMode))
+            .expect("the default building");
+        // The lists as `save` writes them.
+        let mut whole = Vec::new();
+        b.save(&mut whole);
+        let bytes = frame::encode(
+            &Building::STATE_TAG,
+            Building::STATE_VERSION,
+            TABLE.guid,
+            &Common {
+                phase: Phase::StepComplete,
+                experiment: Experiment::default(),
+                time: 0.0,
+                flag: false,
+            },
+            |out| out.extend_from_slice(&whole),
+        );
+        let (_, mut part) = frame::decode(
+            &bytes,
+            &Building::STATE_TAG,
+            Building::STATE_VERSION,
+            TABLE.guid,
+            "Building",
+        )
+        .expect("frame");
+        let lists = [part.f64_list(), part.f64_list(), part.f64_list()].map(|l| l.expect("list"));
+        assert!(!lists[2].is_empty());
+        let good = payload(&lists);
+        assert!(load(Phase::StepComplete, |out| out.extend_from_slice(&good)).is_ok());
+        for k in 0..3 {
+            for longer in [false, true] {
+                let mut changed = lists.clone();
+                if longer {
+                    changed[k].push(0.0);
+                } else {
+                    changed[k].pop();
+                }
+                let bad = payload(&changed);
+                let refused = load(Phase::StepComplete, |out| out.extend_from_slice(&bad));
+                assert!(refused.is_err(), "list {k} longer {longer}");
+            }
+        }
+        // The state of a simulation with a value not finite.
+        let mut changed = lists.clone();
+        changed[2][0] = f64::NAN;
+        let bad = payload(&changed);
+        assert!(load(Phase::StepComplete, |out| out.extend_from_slice(&bad)).is_err());
+    }
+}

@@ -101,3 +101,6 @@ fn broken<S: Slave>(
     );
     Status::Error as fmi2Status
 }
+
+#[cfg(test)]
+mod tests;

@@ -166,3 +166,60 @@ pub unsafe fn fmi2DeSerializeFMUstate<S: Slave>(
         Ok(Status::Ok)
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exports::tests::{Host, Testy, logs_of};
+
+    /// A box whose mark is not this FMU's state mark is refused, even when it holds a good
+    /// state: the mark wiped by fmi2FreeFMUstate (0), an instance's mark, any other word. The
+    /// boxes are real `StateBox`es, so that accepting one (the mutants of `state_mark`) is a
+    /// wrong answer, not undefined behaviour.
+    #[test]
+    fn only_a_box_with_this_fmus_state_mark_is_a_state() {
+        let name = "marks";
+        let host = Host::new(name, None);
+        assert_eq!(host.step(1.0), fmi2Status_fmi2OK);
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        // SAFETY: our live instance, a valid out slot.
+        assert_eq!(
+            unsafe { fmi2GetFMUstate::<Testy>(host.c, &mut state) },
+            fmi2Status_fmi2OK
+        );
+        // SAFETY: a state just made by fmi2GetFMUstate, not freed.
+        let bytes = unsafe { &*(state as *const StateBox) }.bytes.clone();
+        for magic in [0, 1, u64::MAX, Testy::MARK] {
+            let mut forged = StateBox {
+                magic,
+                bytes: bytes.clone(),
+            };
+            let p = &mut forged as *mut StateBox as fmi2FMUstate;
+            // SAFETY: our live instance; `p` points to a StateBox.
+            assert_eq!(
+                unsafe { fmi2SetFMUstate::<Testy>(host.c, p) },
+                fmi2Status_fmi2Error,
+                "mark {magic:#x}"
+            );
+            let logs = logs_of(name);
+            assert_eq!(
+                logs.last().map(|(_, m)| m.as_str()),
+                Some("fmi2SetFMUstate: the FMU state pointer is null or not a state of this FMU")
+            );
+        }
+        assert_eq!(logs_of(name).len(), 4);
+        // The state itself is taken, and freed once.
+        assert_eq!(host.step(1.0), fmi2Status_fmi2OK);
+        // SAFETY: our live instance and state.
+        unsafe {
+            assert_eq!(fmi2SetFMUstate::<Testy>(host.c, state), fmi2Status_fmi2OK);
+            assert_eq!(host.instance().context.time, 1.0);
+            assert_eq!(
+                fmi2FreeFMUstate::<Testy>(host.c, &mut state),
+                fmi2Status_fmi2OK
+            );
+        }
+        assert!(state.is_null());
+        assert_eq!(logs_of(name).len(), 4);
+    }
+}

@@ -344,3 +344,20 @@ fn slamming_mass_ratio_may_take_all_the_liquid() {
     assert!(ok(exact), "{exact}");
     assert!(!ok(exact * (1.0 + 1e-12)));
 }
+
+/// A violent impulse between steps (base.a from 0.2 to 20 m/s^2, 2 g) makes the shallow-water
+/// waves faster within a substep than the CFL step taken from the speeds before it allowed:
+/// substeps are taken again, and each attempt, rejected or not, costs the scheme's ten
+/// right-hand sides.
+#[test]
+fn rejected_shallow_water_substeps_are_counted_and_cost_their_evaluations() {
+    let p = StartValues::default()
+        .with(vr::MODEL, 5.0)
+        .with(vr::SWE_CELLS, 20.0);
+    let mut sim = damper(&p);
+    let calm = sim.step(0.0, 0.1, &held(0.2)).expect("step").stats;
+    assert_eq!(calm.rejected, 0, "{calm:?}");
+    let stats = sim.step(0.1, 0.1, &held(20.0)).expect("step").stats;
+    assert!(stats.rejected > 0 && stats.accepted > 1, "{stats:?}");
+    assert_eq!(stats.evaluations, 10 * (stats.accepted + stats.rejected));
+}
