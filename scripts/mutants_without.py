@@ -15,6 +15,9 @@ import os
 import re
 import sys
 
+if len(sys.argv) < 3 or sys.argv[1] in ("-h", "--help"):
+    print(__doc__.strip())
+    sys.exit(0 if len(sys.argv) > 1 and sys.argv[1] in ("-h", "--help") else 2)
 out, patterns = sys.argv[1], sys.argv[2:]
 outcomes = json.load(open(os.path.join(out, "outcomes.json")))["outcomes"]
 failed = re.compile(r"^test (\S+) \.\.\. FAILED$")
