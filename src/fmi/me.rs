@@ -4,7 +4,7 @@
 //! states) and that the states are finite. Value references become the model's states, inputs,
 //! derivatives and outputs here; the model computes J d.
 
-use fmi2_slave::{Context, Continuous, Refusal, Reply, Status, refuse};
+use fmi2_slave::{Context, Continuous, EventUpdate, Refusal, Reply, Status, refuse};
 
 use super::params::output_of;
 use super::slave::Tld;
@@ -116,10 +116,11 @@ impl Tld {
 impl Continuous for Tld {
     const STATES: usize = STATES;
     const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
-        "Model Exchange offers model = Linear (modes = 1), Nonlinear and Auto with amplitude = \
-         Fixed; the states are slosh.x, slosh.v, energy.input, energy.dissipated. \
-         SloshingSlamming, ShallowWater and amplitude = Tracked are Co-Simulation only \
-         (fmi2ExitInitializationMode says why); see docs/MODEL_EXCHANGE.md",
+        "Model Exchange offers model = Linear (modes = 1), Nonlinear and Auto; the states are \
+         slosh.x, slosh.v, energy.input, energy.dissipated. amplitude = Tracked samples base.a \
+         and base.v at time events, 100 per natural sloshing period. SloshingSlamming and \
+         ShallowWater are Co-Simulation only (fmi2ExitInitializationMode says why); see \
+         docs/MODEL_EXCHANGE.md",
     );
 
     fn offers_model_exchange(&self) -> Result<(), String> {
@@ -161,6 +162,20 @@ impl Continuous for Tld {
             &d,
             dx,
         )
+    }
+
+    /// The tracked amplitude's samples are time events (none for a fixed amplitude); the
+    /// continuous states never change at an event.
+    fn event_update(&mut self, context: &Context) -> Result<EventUpdate, Refusal> {
+        let inputs = self.values.inputs([0.0; 2]);
+        let sim = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| refuse("fmi2NewDiscreteStates: no simulation (not initialised)"))?;
+        Ok(EventUpdate {
+            states_changed: false,
+            next_event: sim.amplitude_event(context.experiment.start, context.time, &inputs),
+        })
     }
 
     fn nominals(&self, out: &mut [f64]) -> Reply {
