@@ -10,9 +10,11 @@
  * 16 shallow-water cells, enough to allocate everything and cheap under valgrind). Afterwards it
  * measures the heap one initialised instance holds, from 1000 live instances at once.
  * With -DNX=n (the model description's continuous states), cycles also run a Model
- * Exchange instance of the same configuration (every configuration, one round in 50) (-DVR_AMPLITUDE=vr: amplitude = Fixed): the event
- * iteration, continuous-time mode, states and derivatives, a refused non-finite state, a saved
- * and restored state; a configuration ME does not offer is refused at exit (fmi2Error) and freed.
+ * Exchange instance of the same configuration (every configuration, one round in 50;
+ * -DVR_AMPLITUDE=vr: amplitude = Fixed and Tracked, whose samples are time events, in
+ * alternate ME rounds): the event iteration, the time events, continuous-time mode, states
+ * and derivatives, a refused non-finite state, a saved and restored state; a configuration ME
+ * does not offer is refused at exit (fmi2Error) and freed.
  * Exit status 0 = all calls returned the expected status. */
 #include <dlfcn.h>
 #include <malloc.h>
@@ -95,16 +97,18 @@ int main(int argc, char **argv) {
     fmi2SetContinuousStates_t fmi2SetContinuousStates =
         (fmi2SetContinuousStates_t)dlsym(lib, "fmi2SetContinuousStates");
     fmi2Mode_t fmi2EnterContinuousTimeMode = (fmi2Mode_t)dlsym(lib, "fmi2EnterContinuousTimeMode");
+    fmi2Mode_t fmi2EnterEventMode = (fmi2Mode_t)dlsym(lib, "fmi2EnterEventMode");
     fmi2CompletedIntegratorStep_t fmi2CompletedIntegratorStep =
         (fmi2CompletedIntegratorStep_t)dlsym(lib, "fmi2CompletedIntegratorStep");
     fmi2NewDiscreteStates_t fmi2NewDiscreteStates =
         (fmi2NewDiscreteStates_t)dlsym(lib, "fmi2NewDiscreteStates");
     if (!fmi2SetTime || !fmi2GetContinuousStates || !fmi2GetDerivatives || !fmi2SetContinuousStates
-        || !fmi2EnterContinuousTimeMode || !fmi2CompletedIntegratorStep || !fmi2NewDiscreteStates) {
+        || !fmi2EnterContinuousTimeMode || !fmi2CompletedIntegratorStep || !fmi2NewDiscreteStates
+        || !fmi2EnterEventMode) {
         fprintf(stderr, "missing a Model Exchange function\n");
         return 2;
     }
-    unsigned long me_runs = 0;
+    unsigned long me_runs = 0, time_events = 0;
 #endif
     callbacks_t cb = { logger, NULL, NULL, NULL, NULL };
     /* Value references from modelDescription.xml, passed in by scripts/leakcheck. */
@@ -164,10 +168,11 @@ int main(int argc, char **argv) {
         /* Every configuration in turn, one round in 50 (valgrind makes an ME run of 20 steps
          * of the 44-state building cost about 0.1 s). */
 #if defined(VR_CYCLE) && defined(CYCLE_N)
-        const int me_round = (cycle / CYCLE_N) % 50 == 0;
+        const unsigned long me_turn = (unsigned long)cycle / CYCLE_N;
 #else
-        const int me_round = cycle % 50 == 0;
+        const unsigned long me_turn = (unsigned long)cycle;
 #endif
+        const int me_round = me_turn % 50 == 0;
         if (!me_round) continue;
         comp_t m = fmi2Instantiate("leak-me", 0, guid, NULL, &cb, 0, 0);
         if (!m) { fprintf(stderr, "instantiate (Model Exchange) failed\n"); return 1; }
@@ -181,8 +186,8 @@ int main(int argc, char **argv) {
 #endif
 #ifdef VR_AMPLITUDE
         const unsigned amplitude = VR_AMPLITUDE;
-        const int fixed = 1;
-        CHECK(fmi2SetInteger(m, &amplitude, 1, &fixed), 0);
+        const int source = 1 + (int)(me_turn / 50 % 2);
+        CHECK(fmi2SetInteger(m, &amplitude, 1, &source), 0);
 #endif
         if (fmi2ExitInitializationMode(m) == 0) {
             info_t info;
@@ -201,6 +206,12 @@ int main(int argc, char **argv) {
                 CHECK(fmi2SetContinuousStates(m, xs, NX), 0);
                 int enter = 0, stop = 0;
                 CHECK(fmi2CompletedIntegratorStep(m, 1, &enter, &stop), 0);
+                if (info.next_defined && tm >= info.next) {
+                    CHECK(fmi2EnterEventMode(m), 0);
+                    CHECK(fmi2NewDiscreteStates(m, &info), 0);
+                    CHECK(fmi2EnterContinuousTimeMode(m), 0);
+                    time_events++;
+                }
                 if (k == 10) CHECK(fmi2GetFMUstate(m, &saved), 0);
             }
             double bad_states[NX];
@@ -217,7 +228,8 @@ int main(int argc, char **argv) {
     }
     printf("leak_host: %d cycles, %lu log messages, last slosh.x %.6e\n", cycles, messages, x);
 #ifdef NX
-    printf("leak_host: %lu of them ran Model Exchange (%d states)\n", me_runs, NX);
+    printf("leak_host: %lu of them ran Model Exchange (%d states), %lu time events\n", me_runs, NX,
+           time_events);
     if (cycles > 0 && me_runs == 0) { fprintf(stderr, "no cycle ran Model Exchange\n"); return 1; }
 #endif
 
