@@ -1,15 +1,16 @@
 //! Model Exchange, the models' side: which models a host's own solver can integrate, and their
 //! continuous states. The offered models are one oscillator of Eq 2.11 (Linear with one mode,
-//! Nonlinear, Auto), whose states are the sloshing mass's relative displacement and velocity
-//! and the two energy integrals, [x, v, energy.input, energy.dissipated]; their time
-//! derivatives are the exact output rates every model already provides ([`Model::rate`]), so
-//! no equation is written twice. Knows no FMI.
+//! Nonlinear, Auto, the sloshing mode of SloshingSlamming), whose states are the sloshing
+//! mass's relative displacement and velocity and the two energy integrals, [x, v,
+//! energy.input, energy.dissipated], and S^2's impact mass, [impact.z, impact.v] (the other
+//! models keep these two at 0, their derivatives 0); their time derivatives are the exact
+//! output rates every model already provides ([`Model::rate`]), so no equation is written
+//! twice. S^2's impacts are state events (`model::events`). Knows no FMI.
 //!
-//! Not offered, each with its reason: SloshingSlamming (its impacts are instants that change
-//! the velocity: state events with an event iteration, not yet written) and ShallowWater (its
-//! 2 x swe.cells states cannot be declared in an FMI 2.0 model description whose number of
-//! states is fixed, while swe.cells is a parameter). A Linear model of more than one mode
-//! would need more states than the model description declares.
+//! Not offered, with its reason: ShallowWater (its 2 x swe.cells states cannot be declared in
+//! an FMI 2.0 model description whose number of states is fixed, while swe.cells is a
+//! parameter). A Linear model of more than one mode would need more states than the model
+//! description declares.
 //!
 //! Directional derivatives (J d, for a host's implicit solver): the exact derivatives of the
 //! same rates in the states and the base acceleration, the damping ratio fixed (amplitude =
@@ -22,11 +23,14 @@ use super::rates::{Change, Oscillator};
 use super::registry::AnyModel;
 use super::{Observable, Output};
 
-/// Numbers of continuous states: x, v, energy.input, energy.dissipated.
-pub const STATES: usize = 4;
+/// Numbers of continuous states: x, v, energy.input, energy.dissipated, impact.z, impact.v.
+pub const STATES: usize = 6;
+/// Where S^2's impact mass's position and velocity are among the states.
+pub const IMPACT_Z: usize = 4;
+pub const IMPACT_V: usize = 5;
 
 /// The outputs whose rates are the states' derivatives, in state order.
-pub const RATES: [Output; STATES] = [
+pub const RATES: [Output; 4] = [
     Output::X,
     Output::V,
     Output::EnergyInput,
@@ -55,9 +59,10 @@ pub struct Direction {
 pub struct Tangent {
     /// Of the states' derivatives, in state order.
     pub derivatives: [f64; STATES],
-    /// Of the force on the tanks [N] and of the stored energy [J].
+    /// Of the force on the tanks [N], of the stored energy [J] and of impact.z [m].
     pub force: f64,
     pub stored: f64,
+    pub impact_z: f64,
 }
 
 impl AnyModel {
@@ -70,7 +75,8 @@ impl AnyModel {
             },
             AnyModel::Nonlinear(m) => Some(m.oscillator()),
             AnyModel::Auto(m) => Some(m.oscillator()),
-            AnyModel::SloshingSlamming(_) | AnyModel::ShallowWater(_) => None,
+            AnyModel::SloshingSlamming(m) => Some(m.oscillator()),
+            AnyModel::ShallowWater(_) => None,
         }
     }
 
@@ -88,11 +94,25 @@ impl AnyModel {
             da: d.a,
         };
         // The energies' derivatives do not read the energies: their columns are 0.
-        Ok(Tangent {
-            derivatives: RATES.map(|which| o.rate_tangent(which, a, change).unwrap_or(0.0)),
+        let mut t = Tangent {
+            derivatives: [0.0; STATES],
             force: o.force_tangent(change),
             stored: o.stored_tangent(change),
-        })
+            impact_z: 0.0,
+        };
+        for (k, which) in RATES.into_iter().enumerate() {
+            t.derivatives[k] = o.rate_tangent(which, a, change).unwrap_or(0.0);
+        }
+        // S^2's impact mass: a free mass in flight (no spring, no damper), still on a wall.
+        if let AnyModel::SloshingSlamming(m) = self {
+            let i = m.impact_tangent(a, d.states[IMPACT_V], d.a);
+            t.derivatives[2] += i.power;
+            t.derivatives[IMPACT_Z] = i.z_rate;
+            t.derivatives[IMPACT_V] = i.v_rate;
+            t.stored += i.kinetic;
+            t.impact_z = d.states[IMPACT_Z];
+        }
+        Ok(t)
     }
 
     /// Ok if the host's solver can integrate this model; Err: why not.
@@ -102,12 +122,10 @@ impl AnyModel {
                 "model = Linear with modes > 1: Model Exchange declares {STATES} continuous states \
                  (one mode); use modes = 1, or Co-Simulation for more modes"
             )),
-            AnyModel::Linear(_) | AnyModel::Nonlinear(_) | AnyModel::Auto(_) => Ok(()),
-            AnyModel::SloshingSlamming(_) => Err(
-                "model = SloshingSlamming is Co-Simulation only for now: its impacts need state \
-                 events (the gap to each wall as event indicator) that are not yet offered"
-                    .into(),
-            ),
+            AnyModel::Linear(_)
+            | AnyModel::Nonlinear(_)
+            | AnyModel::Auto(_)
+            | AnyModel::SloshingSlamming(_) => Ok(()),
             AnyModel::ShallowWater(_) => Err(
                 "model = ShallowWater is Co-Simulation only: its 2 x swe.cells states cannot be \
                  declared in an FMI 2.0 model description, where the number of states is fixed \
@@ -117,15 +135,21 @@ impl AnyModel {
         }
     }
 
-    /// The continuous states [x, v, work in, dissipated]; `initial_energy` is counted as input
-    /// (as the output energy.input does).
+    /// The continuous states [x, v, work in, dissipated, impact.z, impact.v]; `initial_energy`
+    /// is counted as input (as the output energy.input does).
     pub fn continuous_states(&self, initial_energy: f64) -> [f64; STATES] {
         let (x, v) = self.sloshing();
+        let (z, vz) = match self {
+            AnyModel::SloshingSlamming(m) => m.impact_state(),
+            _ => (0.0, 0.0),
+        };
         [
             x,
             v,
             initial_energy + self.observe(Observable::WorkIn),
             self.observe(Observable::Dissipated),
+            z,
+            vz,
         ]
     }
 
@@ -135,6 +159,12 @@ impl AnyModel {
         s: &[f64; STATES],
         initial_energy: f64,
     ) -> Result<(), String> {
+        if let AnyModel::SloshingSlamming(m) = self {
+            let (z, vz) = (s[IMPACT_Z], s[IMPACT_V]);
+            m.set_continuous(s[0], s[1], s[2] - initial_energy, s[3], z, vz);
+            return Ok(());
+        }
+        // The impact mass's states: unused here (kept at 0 and read back as 0).
         let mass = self.sloshing_mass();
         let mut saved = Vec::with_capacity(self.state_len());
         self.save(&mut saved);
@@ -147,7 +177,14 @@ impl AnyModel {
 
     /// The states' time derivatives under base acceleration `a`.
     pub fn continuous_derivatives(&self, a: f64) -> [f64; STATES] {
-        RATES.map(|which| self.rate(which, a, 0.0))
+        let mut d = [0.0; STATES];
+        for (k, which) in RATES.into_iter().enumerate() {
+            d[k] = self.rate(which, a, 0.0);
+        }
+        if let AnyModel::SloshingSlamming(m) = self {
+            (d[IMPACT_Z], d[IMPACT_V]) = m.impact_rates(a);
+        }
+        d
     }
 }
 
@@ -179,10 +216,15 @@ mod tests {
         ] {
             let mut m = model(item, 1.0);
             assert!(m.offers_model_exchange().is_ok(), "{item:?}");
-            let s = [0.0123, -0.045, 0.75, 0.125];
+            let mut s = [0.0; STATES];
+            s[..4].copy_from_slice(&[0.0123, -0.045, 0.75, 0.125]);
+            // The impact mass's states, which these models have not: ignored, read as 0,
+            // their derivatives 0.
+            (s[IMPACT_Z], s[IMPACT_V]) = (0.01, 0.2);
             m.set_continuous_states(&s, 0.25).expect("takes them");
             let back = m.continuous_states(0.25);
-            for k in 0..STATES {
+            assert_eq!((back[IMPACT_Z], back[IMPACT_V]), (0.0, 0.0), "{item:?}");
+            for k in 0..4 {
                 assert!(
                     (back[k] - s[k]).abs() <= 1e-14 * s[k].abs().max(1.0),
                     "{item:?} state {k}: {} vs {}",
@@ -193,6 +235,7 @@ mod tests {
             assert_eq!(m.sloshing(), (s[0], s[1]));
             let d = m.continuous_derivatives(0.3);
             assert_eq!(d[0], s[1], "{item:?}");
+            assert_eq!((d[IMPACT_Z], d[IMPACT_V]), (0.0, 0.0), "{item:?}");
             // The base's power on the sloshing mass, -m a v.
             let want = -m.sloshing_mass() * 0.3 * s[1];
             assert!((d[2] - want).abs() <= 1e-14 * want.abs(), "{item:?}");
@@ -204,7 +247,6 @@ mod tests {
     fn models_not_offered_say_why() {
         let why = |m: AnyModel| m.offers_model_exchange().err().unwrap_or_default();
         assert!(why(model(ModelKindItem::Linear, 3.0)).contains("modes = 1"));
-        assert!(why(model(ModelKindItem::SloshingSlamming, 1.0)).contains("state events"));
         assert!(why(model(ModelKindItem::ShallowWater, 1.0)).contains("swe.cells"));
     }
 
@@ -213,7 +255,6 @@ mod tests {
     fn models_not_offered_have_no_tangent() {
         for (item, modes) in [
             (ModelKindItem::Linear, 3.0),
-            (ModelKindItem::SloshingSlamming, 1.0),
             (ModelKindItem::ShallowWater, 1.0),
         ] {
             let m = model(item, modes);

@@ -112,7 +112,6 @@ def test_building_against_dop853(rtol):
 
 
 @pytest.mark.parametrize("start, why", [
-    ({"model": item("model", "SloshingSlamming")}, "state events"),
     ({"model": item("model", "ShallowWater")}, "swe.cells"),
     ({"model": item("model", "Linear"), "modes": 3}, "modes = 1"),
     ({"model": item("model", "Nonlinear"), "amplitude": item("amplitude", "Tracked")}, "Tracked"),
