@@ -289,3 +289,103 @@ fn chattering_ends_at_rest_and_the_push_turning_releases_it() {
     }
     assert!(got[199][1] < 0.0, "flew to the other wall");
 }
+
+/// The derivative variables in state order, and the Real outputs: the unknowns of J.
+fn unknowns() -> Vec<u32> {
+    use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType};
+    let derivatives = [
+        vr::DER_SLOSH_X_,
+        vr::DER_SLOSH_V_,
+        vr::DER_ENERGY_INPUT_,
+        vr::DER_ENERGY_DISSIPATED_,
+        vr::DER_IMPACT_Z_,
+        vr::DER_IMPACT_V_,
+    ];
+    let outputs = VARIABLES
+        .iter()
+        .filter(|v| v.causality == Causality::Output && v.ty == VarType::Real)
+        .map(|v| v.vr);
+    derivatives.into_iter().chain(outputs).collect()
+}
+
+/// The unknowns' values at the states `x` and base acceleration `a`.
+fn unknown_values(inst: &Instance, x: &[f64], a: f64) -> Vec<f64> {
+    assert_eq!(inst.set_states(x), OK, "{:?}", inst.logs());
+    assert_eq!(inst.set_real(vr::BASE_A, a), OK);
+    let (s, mut v) = inst.derivatives(N);
+    assert_eq!(s, OK);
+    v.extend(unknowns()[N..].iter().map(|&r| inst.real(r)));
+    v
+}
+
+/// fmi2GetDirectionalDerivative for S^2, every column (the six states and base.a) of J for the
+/// six derivatives and every Real output, against central differences of fmi2GetDerivatives and
+/// fmi2GetReal (S^2 is linear in them within a mode: the differences are exact but for
+/// rounding), with the impact mass in flight and resting on a wall.
+#[test]
+fn directional_derivatives_in_flight_and_at_rest_are_the_differences() {
+    // In flight: a state with everything moving; at rest: pressed onto +d/2 until the bounces
+    // end, and a velocity the host set there (which the stored energy reads, the rates not).
+    let flying = s2("me-s2-jacobian-flying", true, 0.8);
+    let mut resting = Host::new(s2("me-s2-jacobian-resting", true, 0.8));
+    resting.run(&[-2.0; 100]);
+    let mut at_rest = resting.x.clone();
+    at_rest[5] = 0.1;
+    let cases = [
+        (
+            &Host::new(flying).inst,
+            vec![0.012, -0.03, 0.4, 0.1, 0.02, 0.15],
+            -0.3,
+            "in flight",
+        ),
+        (&resting.inst, at_rest, -2.0, "at rest"),
+    ];
+    let u = unknowns();
+    for (inst, x, a, what) in cases {
+        let knowns = [
+            vr::SLOSH_X,
+            vr::SLOSH_V,
+            vr::ENERGY_INPUT,
+            vr::ENERGY_DISSIPATED,
+            vr::IMPACT_Z,
+            vr::IMPACT_V,
+            vr::BASE_A,
+        ];
+        for (k, &known) in knowns.iter().enumerate() {
+            unknown_values(inst, &x, a);
+            let mut j = vec![f64::NAN; u.len()];
+            let s = unsafe {
+                inst.lib.fmi2GetDirectionalDerivative(
+                    inst.c,
+                    u.as_ptr(),
+                    u.len(),
+                    &known,
+                    1,
+                    &1.0,
+                    j.as_mut_ptr(),
+                )
+            };
+            assert_eq!(s, OK, "{:?}", inst.logs());
+            let h = 1e-6;
+            let (mut xp, mut xm, mut ap, mut am) = (x.clone(), x.clone(), a, a);
+            if k < N {
+                xp[k] += h;
+                xm[k] -= h;
+            } else {
+                ap += h;
+                am -= h;
+            }
+            let (up, down) = (unknown_values(inst, &xp, ap), unknown_values(inst, &xm, am));
+            for i in 0..u.len() {
+                let fd = (up[i] - down[i]) / (2.0 * h);
+                let tol = 1e-7 * (1.0 + fd.abs()) + 1e3 * f64::EPSILON * up[i].abs() / h;
+                assert!(
+                    (j[i] - fd).abs() <= tol,
+                    "{what}: d[{}]/d[{known}] = {} by J d, {fd} by differences",
+                    u[i],
+                    j[i]
+                );
+            }
+        }
+    }
+}

@@ -63,19 +63,24 @@ impl SloshingSlamming {
         }
     }
 
-    /// J d of the impact mass's part under base acceleration `a` (all 0 at rest on a wall).
-    /// Neither rate reads z: the tangent has no dz.
+    /// J d of the impact mass's part under base acceleration `a` (the rates' all 0 at rest on
+    /// a wall). Neither rate reads z: the tangent has no dz.
     pub fn impact_tangent(&self, a: f64, dv: f64, da: f64) -> ImpactTangent {
-        if !self.flying() {
-            return ImpactTangent::default();
-        }
         let (m, v) = (self.impact_mass, self.state.v);
+        // d(m v^2/2): the stored energy reads the velocity in either mode.
+        let kinetic = m * v * dv;
+        if !self.flying() {
+            return ImpactTangent {
+                kinetic,
+                ..ImpactTangent::default()
+            };
+        }
         ImpactTangent {
             z_rate: dv,
             v_rate: -da,
-            // d(-m a v) and d(m v^2/2).
+            // d(-m a v).
             power: -m * (a * dv + v * da),
-            kinetic: m * v * dv,
+            kinetic,
         }
     }
 
