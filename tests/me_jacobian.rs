@@ -13,7 +13,7 @@ use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType, vr};
 
 /// The states perturbed here (those of the oscillator models), of all the continuous states.
 const N: usize = 4;
-const STATES: usize = 6;
+const STATES: usize = 24;
 const LINEAR: i32 = 1;
 const NONLINEAR: i32 = 2;
 const AUTO: i32 = 4;

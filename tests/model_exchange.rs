@@ -9,8 +9,8 @@ use common::*;
 use tld_fmu::fmi::vars::vr;
 
 /// Continuous states of TLD.fmu in ME: slosh.x, slosh.v, energy.input, energy.dissipated,
-/// impact.z, impact.v.
-const N: usize = 6;
+/// impact.z, impact.v, and the Linear model's mode[n].x, mode[n].v (n = 2..10).
+const N: usize = 24;
 /// Items: model = Linear (1), Nonlinear (2), SloshingSlamming (3); damping Constant (1);
 /// amplitude Fixed (1).
 const LINEAR: i32 = 1;
@@ -127,8 +127,12 @@ fn calls_out_of_order_say_what_to_call_first() {
     assert_eq!(me.new_discrete_states().0, ERROR);
     // Wrong array lengths, and a non-finite state.
     assert_eq!(me.derivatives(N + 1).0, ERROR);
-    assert_eq!(me.set_states(&[0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0]), ERROR);
-    assert_eq!(me.set_states(&[1e6, 0.0, 0.0, 0.0, 0.0, 0.0]), ERROR);
+    let mut bad = [0.0; N];
+    bad[1] = f64::NAN;
+    assert_eq!(me.set_states(&bad), ERROR);
+    let mut far = [0.0; N];
+    far[0] = 1e6;
+    assert_eq!(me.set_states(&far), ERROR);
     let (_, x) = me.states(N);
     assert_eq!(
         x, [0.0; N],
@@ -141,7 +145,7 @@ fn calls_out_of_order_say_what_to_call_first() {
         "fmi2DoStep is not allowed in state EventMode",
         "fmi2CoSimulation",
         "Call fmi2EnterEventMode first",
-        "the model description declares 6",
+        "the model description declares 24",
         "state 1 is NaN",
         "ran away",
     ] {
@@ -253,9 +257,9 @@ fn instantiating_for_model_exchange_says_what_is_offered() {
     unsafe { lib.fmi2FreeInstance(c) };
     let said = logs_of("me-note").join("\n");
     for part in [
-        "Linear (modes = 1)",
+        "Linear (modes <= 10)",
         "SloshingSlamming (impacts as state events)",
-        "ShallowWater and amplitude = Tracked",
+        "ShallowWater, Linear with more modes and amplitude = Tracked",
     ] {
         assert!(said.contains(part), "no '{part}' in: {said}");
     }

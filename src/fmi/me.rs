@@ -9,30 +9,54 @@ use fmi2_slave::{Context, Continuous, EventUpdate, Refusal, Reply, Status, refus
 use super::params::output_of;
 use super::slave::Tld;
 use super::vars::{VARIABLES, VarType, index_of, vr};
-use crate::model::continuous::{Direction, STATES};
+use crate::model::continuous::{BANK, Direction, STATES};
 use crate::model::events::EVENT_INDICATORS;
 use crate::model::slamming::Event;
 use crate::model::{Damper, Unknown};
 
 /// The state derivative variables, in state order.
-const DERIVATIVES: [u32; STATES] = [
-    vr::DER_SLOSH_X_,
-    vr::DER_SLOSH_V_,
-    vr::DER_ENERGY_INPUT_,
-    vr::DER_ENERGY_DISSIPATED_,
-    vr::DER_IMPACT_Z_,
-    vr::DER_IMPACT_V_,
-];
+const DERIVATIVES: [u32; STATES] = with_bank(
+    [
+        vr::DER_SLOSH_X_,
+        vr::DER_SLOSH_V_,
+        vr::DER_ENERGY_INPUT_,
+        vr::DER_ENERGY_DISSIPATED_,
+        vr::DER_IMPACT_Z_,
+        vr::DER_IMPACT_V_,
+    ],
+    2,
+);
 
 /// The continuous state variables, in state order.
-const STATE_VARIABLES: [u32; STATES] = [
-    vr::SLOSH_X,
-    vr::SLOSH_V,
-    vr::ENERGY_INPUT,
-    vr::ENERGY_DISSIPATED,
-    vr::IMPACT_Z,
-    vr::IMPACT_V,
-];
+const STATE_VARIABLES: [u32; STATES] = with_bank(
+    [
+        vr::SLOSH_X,
+        vr::SLOSH_V,
+        vr::ENERGY_INPUT,
+        vr::ENERGY_DISSIPATED,
+        vr::IMPACT_Z,
+        vr::IMPACT_V,
+    ],
+    0,
+);
+
+/// `first`, then the Linear model's bank mode[n].x, mode[n].v (n = 2, 3, ...), whose value
+/// references run four a mode from mode[2].x's (x, v, der(x), der(v)): `offset` 2 gives the
+/// derivatives. The tests check every name.
+const fn with_bank(first: [u32; BANK], offset: u32) -> [u32; STATES] {
+    let mut out = [0; STATES];
+    let mut k = 0;
+    while k < STATES {
+        out[k] = if k < BANK {
+            first[k]
+        } else {
+            let (mode, which) = ((k - BANK) / 2, (k - BANK) % 2);
+            vr::MODE_2__X + 4 * mode as u32 + which as u32 + offset
+        };
+        k += 1;
+    }
+    out
+}
 
 /// The direction the host gives as changes `dv` of the states and inputs `knowns`.
 fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
@@ -48,7 +72,8 @@ fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
                     return Err(refuse(format!(
                         "fmi2GetDirectionalDerivative: value reference {r} is neither a \
                          continuous state (slosh.x, slosh.v, energy.input, energy.dissipated, \
-                         impact.z, impact.v) nor an input (base.a, base.v, base.x)"
+                         impact.z, impact.v, mode[n].x, mode[n].v) nor an input (base.a, base.v, \
+                         base.x)"
                     )));
                 }
             },
@@ -131,11 +156,12 @@ impl Continuous for Tld {
     const STATES: usize = STATES;
     const EVENT_INDICATORS: usize = EVENT_INDICATORS;
     const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
-        "Model Exchange offers model = Linear (modes = 1), Nonlinear, Auto and \
+        "Model Exchange offers model = Linear (modes <= 10), Nonlinear, Auto and \
          SloshingSlamming (impacts as state events) with amplitude = Fixed; the states are \
-         slosh.x, slosh.v, energy.input, energy.dissipated, impact.z, impact.v. ShallowWater \
-         and amplitude = Tracked are Co-Simulation only (fmi2ExitInitializationMode says why); \
-         see docs/MODEL_EXCHANGE.md",
+         slosh.x, slosh.v, energy.input, energy.dissipated, impact.z, impact.v and mode[n].x, \
+         mode[n].v (n = 2..10, Linear's higher modes). ShallowWater, Linear with more modes and \
+         amplitude = Tracked are Co-Simulation only (fmi2ExitInitializationMode says why); see \
+         docs/MODEL_EXCHANGE.md",
     );
 
     fn offers_model_exchange(&self) -> Result<(), String> {
@@ -236,5 +262,32 @@ impl Continuous for Tld {
         sim.directional_derivatives(&inputs, &d, &unknowns, &mut out)
             .map_err(|why| refuse(format!("{F}: {why}")))?;
         copy_finite(F, "entry", context, inputs.a, &out, dv_unknown)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn name(r: u32) -> &'static str {
+        index_of(r).map_or("?", |k| VARIABLES[k].name)
+    }
+
+    /// The bank's value references name mode[n].x, mode[n].v and their derivatives.
+    #[test]
+    fn the_bank_names_its_modes() {
+        for k in BANK..STATES {
+            let n = 2 + (k - BANK) / 2;
+            let which = if (k - BANK).is_multiple_of(2) { "x" } else { "v" };
+            let state = format!("mode[{n}].{which}");
+            assert_eq!(name(STATE_VARIABLES[k]), state);
+            assert_eq!(name(DERIVATIVES[k]), format!("der({state})"));
+        }
+        for k in 0..BANK {
+            assert_eq!(
+                name(DERIVATIVES[k]),
+                format!("der({})", name(STATE_VARIABLES[k]))
+            );
+        }
     }
 }

@@ -7,10 +7,12 @@
 //! output rates every model already provides ([`Model::rate`]), so no equation is written
 //! twice. S^2's impacts are state events (`model::events`). Knows no FMI.
 //!
+//! The Linear model's modes 2 to [`ME_MODES`] are a bank of (x, v) pairs after these
+//! (`linear::continuous`); the other models keep them at 0, their derivatives 0.
+//!
 //! Not offered, with its reason: ShallowWater (its 2 x swe.cells states cannot be declared in
 //! an FMI 2.0 model description whose number of states is fixed, while swe.cells is a
-//! parameter). A Linear model of more than one mode would need more states than the model
-//! description declares.
+//! parameter); Linear with more than [`ME_MODES`] modes.
 //!
 //! Directional derivatives (J d, for a host's implicit solver): the exact derivatives of the
 //! same rates in the states and the base acceleration, the damping ratio fixed (amplitude =
@@ -19,15 +21,19 @@
 //!
 //! [`Model::rate`]: super::Model::rate
 
+use super::linear::ME_MODES;
 use super::rates::{Change, Oscillator};
 use super::registry::AnyModel;
 use super::{Observable, Output};
 
-/// Numbers of continuous states: x, v, energy.input, energy.dissipated, impact.z, impact.v.
-pub const STATES: usize = 6;
+/// Numbers of continuous states: x, v, energy.input, energy.dissipated, impact.z, impact.v,
+/// then the bank of the Linear model's modes 2 to ME_MODES, (x, v) each.
+pub const STATES: usize = BANK + 2 * (ME_MODES - 1);
 /// Where S^2's impact mass's position and velocity are among the states.
 pub const IMPACT_Z: usize = 4;
 pub const IMPACT_V: usize = 5;
+/// Where the bank of higher modes begins.
+pub const BANK: usize = 6;
 
 /// The outputs whose rates are the states' derivatives, in state order.
 pub const RATES: [Output; 4] = [
@@ -36,11 +42,6 @@ pub const RATES: [Output; 4] = [
     Output::EnergyInput,
     Output::EnergyDissipated,
 ];
-
-/// The saved numbers of every offered model begin with the fundamental oscillator's state per
-/// unit sloshing mass: x, v, work in, dissipated (Linear's first mode, Nonlinear's and Auto's
-/// `y`); the tests check it for each.
-const OSCILLATOR: usize = 4;
 
 /// A direction d in the continuous states and the inputs.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -69,10 +70,7 @@ impl AnyModel {
     /// The model's one oscillator, if it is one of those offered in Model Exchange.
     fn oscillator(&self) -> Option<Oscillator> {
         match self {
-            AnyModel::Linear(m) => match m.modes() {
-                [only] => Some(only.oscillator()),
-                _ => None,
-            },
+            AnyModel::Linear(m) => m.modes().first().map(|first| first.oscillator()),
             AnyModel::Nonlinear(m) => Some(m.oscillator()),
             AnyModel::Auto(m) => Some(m.oscillator()),
             AnyModel::SloshingSlamming(m) => Some(m.oscillator()),
@@ -112,15 +110,25 @@ impl AnyModel {
             t.stored += i.kinetic;
             t.impact_z = d.states[IMPACT_Z];
         }
+        if let AnyModel::Linear(m) = self {
+            let bank = m.bank_tangent(a, &d.states[BANK..], d.a);
+            t.derivatives[BANK..BANK + bank.derivatives.len()].copy_from_slice(&bank.derivatives);
+            t.derivatives[2] += bank.power;
+            t.derivatives[3] += bank.dissipation;
+            t.force += bank.force;
+            t.stored += bank.stored;
+        }
         Ok(t)
     }
 
     /// Ok if the host's solver can integrate this model; Err: why not.
     pub fn offers_model_exchange(&self) -> Result<(), String> {
         match self {
-            AnyModel::Linear(_) if self.state_len() != OSCILLATOR + 3 => Err(format!(
-                "model = Linear with modes > 1: Model Exchange declares {STATES} continuous states \
-                 (one mode); use modes = 1, or Co-Simulation for more modes"
+            AnyModel::Linear(m) if m.modes().len() > ME_MODES => Err(format!(
+                "model = Linear with modes = {}: Model Exchange declares the states of at most \
+                 {ME_MODES} modes (the model description's number of states is fixed); use \
+                 modes <= {ME_MODES}, or Co-Simulation for more modes",
+                m.modes().len()
             )),
             AnyModel::Linear(_)
             | AnyModel::Nonlinear(_)
@@ -139,18 +147,19 @@ impl AnyModel {
     /// is counted as input (as the output energy.input does).
     pub fn continuous_states(&self, initial_energy: f64) -> [f64; STATES] {
         let (x, v) = self.sloshing();
-        let (z, vz) = match self {
-            AnyModel::SloshingSlamming(m) => m.impact_state(),
-            _ => (0.0, 0.0),
-        };
-        [
+        let mut s = [0.0; STATES];
+        s[..4].copy_from_slice(&[
             x,
             v,
             initial_energy + self.observe(Observable::WorkIn),
             self.observe(Observable::Dissipated),
-            z,
-            vz,
-        ]
+        ]);
+        match self {
+            AnyModel::SloshingSlamming(m) => (s[IMPACT_Z], s[IMPACT_V]) = m.impact_state(),
+            AnyModel::Linear(m) => m.bank_states(&mut s[BANK..]),
+            _ => {}
+        }
+        s
     }
 
     /// Take the continuous states `s` (as [`AnyModel::continuous_states`] gives them).
@@ -164,7 +173,13 @@ impl AnyModel {
             m.set_continuous(s[0], s[1], s[2] - initial_energy, s[3], z, vz);
             return Ok(());
         }
-        // The impact mass's states: unused here (kept at 0 and read back as 0).
+        if let AnyModel::Linear(m) = self {
+            m.set_continuous(s[0], s[1], s[2] - initial_energy, s[3], &s[BANK..]);
+            return Ok(());
+        }
+        // Nonlinear's and Auto's saved numbers begin with the oscillator's state per unit
+        // sloshing mass: x, v, work in, dissipated (the tests check it). The impact mass's and
+        // the bank's states: unused here (kept at 0 and read back as 0).
         let mass = self.sloshing_mass();
         let mut saved = Vec::with_capacity(self.state_len());
         self.save(&mut saved);
@@ -181,8 +196,10 @@ impl AnyModel {
         for (k, which) in RATES.into_iter().enumerate() {
             d[k] = self.rate(which, a, 0.0);
         }
-        if let AnyModel::SloshingSlamming(m) = self {
-            (d[IMPACT_Z], d[IMPACT_V]) = m.impact_rates(a);
+        match self {
+            AnyModel::SloshingSlamming(m) => (d[IMPACT_Z], d[IMPACT_V]) = m.impact_rates(a),
+            AnyModel::Linear(m) => m.bank_rates(a, &mut d[BANK..]),
+            _ => {}
         }
         d
     }
@@ -246,7 +263,7 @@ mod tests {
     #[test]
     fn models_not_offered_say_why() {
         let why = |m: AnyModel| m.offers_model_exchange().err().unwrap_or_default();
-        assert!(why(model(ModelKindItem::Linear, 3.0)).contains("modes = 1"));
+        assert!(why(model(ModelKindItem::Linear, 11.0)).contains("modes <= 10"));
         assert!(why(model(ModelKindItem::ShallowWater, 1.0)).contains("swe.cells"));
     }
 
@@ -254,7 +271,7 @@ mod tests {
     #[test]
     fn models_not_offered_have_no_tangent() {
         for (item, modes) in [
-            (ModelKindItem::Linear, 3.0),
+            (ModelKindItem::Linear, 11.0),
             (ModelKindItem::ShallowWater, 1.0),
         ] {
             let m = model(item, modes);

@@ -5,7 +5,7 @@
 //! host's solver has none; it is refused with that reason.
 
 use super::{Damper, per_step};
-use crate::model::continuous::{Direction, IMPACT_V, IMPACT_Z, STATES, Tangent};
+use crate::model::continuous::{BANK, Direction, IMPACT_V, IMPACT_Z, STATES, Tangent};
 use crate::model::{AmplitudeSource, Inputs, Output};
 
 /// What a directional derivative asks for: a state's derivative (in state order) or an output.
@@ -73,6 +73,10 @@ impl Damper {
         n[3] = energy;
         n[IMPACT_Z] = x;
         n[IMPACT_V] = v;
+        // The bank of higher modes: (x, v) pairs.
+        for pair in n[BANK..].chunks_exact_mut(2) {
+            pair[1] = v;
+        }
         n
     }
 

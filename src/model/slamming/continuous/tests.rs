@@ -118,7 +118,8 @@ fn states_round_trip_and_rates_are_the_flight() {
     let mut m = s2(0.7);
     slam(&mut m).state.work_in = 0.25;
     slam(&mut m).state.dissipated = 0.125;
-    let s = [0.01, -0.02, 0.5, 0.3, 0.049, 0.2];
+    let mut s = [0.0; STATES];
+    s[..6].copy_from_slice(&[0.01, -0.02, 0.5, 0.3, 0.049, 0.2]);
     m.set_continuous_states(&s, 0.1).expect("takes them");
     let back = m.continuous_states(0.1);
     for k in 0..STATES {
@@ -140,7 +141,8 @@ fn states_round_trip_and_rates_are_the_flight() {
 fn the_tangent_is_the_derivatives_change() {
     for rest in [false, true] {
         let mut m = s2(0.7);
-        let s = [0.01, -0.02, 0.5, 0.3, 0.03, 0.2];
+        let mut s = [0.0; STATES];
+        s[..6].copy_from_slice(&[0.01, -0.02, 0.5, 0.3, 0.03, 0.2]);
         m.set_continuous_states(&s, 0.0).expect("takes them");
         if rest {
             let sl = slam(&mut m);
