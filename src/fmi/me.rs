@@ -278,7 +278,11 @@ mod tests {
     fn the_bank_names_its_modes() {
         for k in BANK..STATES {
             let n = 2 + (k - BANK) / 2;
-            let which = if (k - BANK).is_multiple_of(2) { "x" } else { "v" };
+            let which = if (k - BANK).is_multiple_of(2) {
+                "x"
+            } else {
+                "v"
+            };
             let state = format!("mode[{n}].{which}");
             assert_eq!(name(STATE_VARIABLES[k]), state);
             assert_eq!(name(DERIVATIVES[k]), format!("der({state})"));
