@@ -9,7 +9,7 @@
 mod common;
 
 use common::*;
-use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType, vr};
+use tld_fmu::fmi::vars::vr;
 
 /// The states perturbed here (those of the oscillator models), of all the continuous states.
 const N: usize = 4;
@@ -52,13 +52,8 @@ fn running(name: &str, model: i32, eta: f64) -> Instance {
     inst
 }
 
-/// The Real outputs, from the model description: every one of them.
 fn outputs() -> Vec<u32> {
-    VARIABLES
-        .iter()
-        .filter(|v| v.causality == Causality::Output && v.ty == VarType::Real)
-        .map(|v| v.vr)
-        .collect()
+    real_outputs()
 }
 
 fn unknowns() -> Vec<u32> {
@@ -67,21 +62,7 @@ fn unknowns() -> Vec<u32> {
 
 /// J's column for the known `known` at the current states and inputs.
 fn column(inst: &Instance, known: u32) -> Vec<f64> {
-    let u = unknowns();
-    let mut j = vec![f64::NAN; u.len()];
-    let s = unsafe {
-        inst.lib.fmi2GetDirectionalDerivative(
-            inst.c,
-            u.as_ptr(),
-            u.len(),
-            &known,
-            1,
-            &1.0,
-            j.as_mut_ptr(),
-        )
-    };
-    assert_eq!(s, OK, "{:?}", inst.logs());
-    j
+    jacobian_column(inst, &unknowns(), known)
 }
 
 /// The unknowns' values: the derivatives, then the outputs.

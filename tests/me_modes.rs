@@ -14,32 +14,18 @@ const N: usize = 24;
 const DT: f64 = 0.01;
 
 fn linear(name: &str, me: bool, modes: i32) -> Instance {
-    let inst = if me {
-        Instance::model_exchange(name)
-    } else {
-        Instance::new(name)
-    };
-    assert_eq!(inst.setup(), OK);
-    for (r, v) in [
+    let integers = [
         (vr::MODEL, 1),
         (vr::MODES, modes),
         (vr::DAMPING, 1),
         (vr::AMPLITUDE, 1),
-    ] {
-        assert_eq!(inst.set_integer(r, v), OK);
-    }
-    assert_eq!(inst.set_real(vr::ZETA, 0.02), OK);
-    assert_eq!(inst.set_real(vr::SLOSH_X0, 0.01), OK);
-    assert_eq!(inst.enter(), OK);
-    inst
-}
-
-fn vr_of(name: &str) -> u32 {
-    VARIABLES
-        .iter()
-        .find(|v| v.name == name)
-        .map(|v| v.vr)
-        .unwrap_or_else(|| panic!("no variable {name}"))
+    ];
+    configured(
+        name,
+        me,
+        &integers,
+        &[(vr::ZETA, 0.02), (vr::SLOSH_X0, 0.01)],
+    )
 }
 
 /// Ten modes under held base motion near the fundamental's resonance for 5 s: RK4 at 0.1 ms

@@ -17,6 +17,14 @@ use tld_fmu::fmi::vars::vr;
 const N: usize = 24;
 /// Those S^2 uses.
 const S2_STATES: usize = 6;
+const S2_NAMES: [&str; S2_STATES] = [
+    "slosh.x",
+    "slosh.v",
+    "energy.input",
+    "energy.dissipated",
+    "impact.z",
+    "impact.v",
+];
 /// Event indicators: the contact functions of the walls +d/2 and -d/2.
 const NZ: usize = 2;
 const S2: i32 = 3;
@@ -24,27 +32,17 @@ const D: f64 = 0.1;
 const E: f64 = 0.4;
 const DT: f64 = 0.01;
 
-/// An S^2 instance of `kind` (ME or CS) with mass exchange `omega`, in initialisation mode.
+/// An S^2 instance (ME or CS) with mass exchange `omega`, out of initialisation mode.
 fn s2(name: &str, me: bool, omega: f64) -> Instance {
-    let inst = if me {
-        Instance::model_exchange(name)
-    } else {
-        Instance::new(name)
-    };
-    assert_eq!(inst.setup(), OK);
-    for (r, v) in [
+    let integers = [(vr::MODEL, S2), (vr::DAMPING, 1), (vr::AMPLITUDE, 1)];
+    let reals = [
         (vr::ZETA, 0.02),
         (vr::SLAMMING_OMEGA, omega),
         (vr::SLAMMING_CLEARANCE, D),
         (vr::SLAMMING_RESTITUTION, E),
         (vr::SLAMMING_MASS_RATIO, 0.01),
-    ] {
-        assert_eq!(inst.set_real(r, v), OK);
-    }
-    for (r, v) in [(vr::MODEL, S2), (vr::DAMPING, 1), (vr::AMPLITUDE, 1)] {
-        assert_eq!(inst.set_integer(r, v), OK);
-    }
-    assert_eq!(inst.enter(), OK);
+    ];
+    let inst = configured(name, me, &integers, &reals);
     assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
     inst
 }
@@ -293,22 +291,10 @@ fn chattering_ends_at_rest_and_the_push_turning_releases_it() {
     assert!(got[199][1] < 0.0, "flew to the other wall");
 }
 
-/// The derivative variables in state order, and the Real outputs: the unknowns of J.
+/// The derivative variables of S^2's states, and the Real outputs: the unknowns of J.
 fn unknowns() -> Vec<u32> {
-    use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType};
-    let derivatives = [
-        vr::DER_SLOSH_X_,
-        vr::DER_SLOSH_V_,
-        vr::DER_ENERGY_INPUT_,
-        vr::DER_ENERGY_DISSIPATED_,
-        vr::DER_IMPACT_Z_,
-        vr::DER_IMPACT_V_,
-    ];
-    let outputs = VARIABLES
-        .iter()
-        .filter(|v| v.causality == Causality::Output && v.ty == VarType::Real)
-        .map(|v| v.vr);
-    derivatives.into_iter().chain(outputs).collect()
+    let derivatives = S2_NAMES.map(|n| vr_of(&format!("der({n})")));
+    derivatives.into_iter().chain(real_outputs()).collect()
 }
 
 /// The unknowns' values at the states `x` and base acceleration `a`.
@@ -350,30 +336,14 @@ fn directional_derivatives_in_flight_and_at_rest_are_the_differences() {
     ];
     let u = unknowns();
     for (inst, x, a, what) in cases {
-        let knowns = [
-            vr::SLOSH_X,
-            vr::SLOSH_V,
-            vr::ENERGY_INPUT,
-            vr::ENERGY_DISSIPATED,
-            vr::IMPACT_Z,
-            vr::IMPACT_V,
-            vr::BASE_A,
-        ];
+        let knowns: Vec<u32> = S2_NAMES
+            .map(vr_of)
+            .into_iter()
+            .chain([vr::BASE_A])
+            .collect();
         for (k, &known) in knowns.iter().enumerate() {
             unknown_values(inst, &x, a);
-            let mut j = vec![f64::NAN; u.len()];
-            let s = unsafe {
-                inst.lib.fmi2GetDirectionalDerivative(
-                    inst.c,
-                    u.as_ptr(),
-                    u.len(),
-                    &known,
-                    1,
-                    &1.0,
-                    j.as_mut_ptr(),
-                )
-            };
-            assert_eq!(s, OK, "{:?}", inst.logs());
+            let j = jacobian_column(inst, &u, known);
             let h = 1e-6;
             let (mut xp, mut xm, mut ap, mut am) = (x.clone(), x.clone(), a, a);
             if k < S2_STATES {
