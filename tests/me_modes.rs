@@ -29,7 +29,7 @@ fn linear(name: &str, me: bool, modes: i32) -> Instance {
 }
 
 /// Ten modes under held base motion near the fundamental's resonance for 5 s: RK4 at 0.1 ms
-/// (omega_10 h = 0.01) against the exact propagator, at every sample.
+/// (omega_10 h = 0.005) against the exact propagator, at every sample.
 #[test]
 fn a_host_integrates_ten_modes_to_the_exact_solution() {
     let modes = 10;

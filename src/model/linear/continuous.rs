@@ -10,8 +10,8 @@ use crate::model::Output;
 use crate::model::rates::{self, Change};
 
 /// The most modes Model Exchange declares states for. Mode n's modal mass falls as
-/// tanh((2n - 1) pi h/a)/(2n - 1)^3: the 10th carries 1.4e-4 of the fundamental's (for shallow
-/// tanks, less for deep ones), and the bank's value references must fit the model
+/// tanh((2n - 1) pi h/a)/(2n - 1)^3: the 10th carries 5.7e-4 of the fundamental's (in the lab
+/// tank, less for deeper ones), and the bank's value references must fit the model
 /// description's range 100-199 (four a mode: x, v and their derivatives).
 pub const ME_MODES: usize = 10;
 
