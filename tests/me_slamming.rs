@@ -367,3 +367,45 @@ fn directional_derivatives_in_flight_and_at_rest_are_the_differences() {
         }
     }
 }
+
+/// An FMU state saved with the impact mass resting on a wall (a discrete mode, not a
+/// continuous state) restores into a new ME instance from its serialised bytes: the same
+/// states, and the same continuation through the release and the flight to the other wall,
+/// bit for bit, with the same events.
+#[test]
+fn a_resting_mass_saves_and_restores_with_its_mode() {
+    let mut a = vec![-2.0; 100];
+    // Still pressed for 0.1 s (a mass restored as flying would hit the wall again), then pulled.
+    a.extend([-2.0; 10]);
+    a.extend([2.0; 100]);
+    let mut first = Host::new(s2("me-s2-save", true, 0.8));
+    first.run(&a[..100]);
+    let bytes = first.inst.serialised();
+    let (saved, t) = (first.x.clone(), first.t);
+    let events = first.events;
+    let end = first.run(&a[100..]);
+
+    let mut second = Host::new(s2("me-s2-restored", true, 0.8));
+    let mut s = restore(&second.inst, &bytes);
+    let (_, x) = second.inst.states(N);
+    assert_eq!(x, saved);
+    (second.t, second.x) = (t, x);
+    let again = second.run(&a[100..]);
+    assert_eq!(
+        again
+            .iter()
+            .map(|r| r.map(f64::to_bits))
+            .collect::<Vec<_>>(),
+        end.iter().map(|r| r.map(f64::to_bits)).collect::<Vec<_>>()
+    );
+    assert_eq!(second.events, first.events - events);
+    assert!(
+        second.events > 3,
+        "the release and new impacts: {}",
+        second.events
+    );
+    assert_eq!(
+        unsafe { second.inst.lib.fmi2FreeFMUstate(second.inst.c, &mut s) },
+        OK
+    );
+}
