@@ -84,9 +84,10 @@ fn the_estimator_is_exact_on_the_linear_oscillator() {
 /// model with the same screens (Tait's pair, S = 0.5, 32 cells, no boundary layers) under
 /// band-limited white-noise base acceleration (0.5-1.5 omega_f, 400 s, the first 50 s skipped)
 /// at two response levels, sigma_X/a = 0.004 and 0.02 (zeta 0.025 and 0.12):
-/// - the model's energy-equivalent damping against 1.880 K sigma_X at its own sigma_X (measured
-///   -4 % and -5 %: allowed 8 %), and not against a sinusoid of the same rms, K sqrt(2) sigma_X,
-///   25 % lower (required more than 15 % off: the test tells the two forms apart);
+/// - the model's energy-equivalent damping against 1.880 K sigma_X at its own sigma_X (+4 % and
+///   -5 % of the law: allowed 8 %), and not against a sinusoid of the same rms,
+///   K sqrt(2) sigma_X, 21-28 % below it (required more than 15 % off: the test tells the two
+///   forms apart);
 /// - the Linear model with the random law at A_e = that sigma_X, driven by the same record:
 ///   its sigma_X within 6 % of the model's (measured +1 % and -4 %);
 /// - the closed-form prediction from the excitation alone, the root of
@@ -138,5 +139,54 @@ fn random_screens_law_matches_the_shallow_water_model() {
             "{predicted} vs {}",
             r.sigma_x
         );
+    }
+}
+
+/// The report behind the random half of docs/SCREENS-SWEEP.md (scripts/screens-report runs it
+/// in a release build): the lab tank with Tait's pair (S = 0.5 and 0.7, no boundary layers) as
+/// model = ShallowWater at 150 cells under band-limited white noise (0.5-1.5 omega_f, 1200 s,
+/// the first 100 s skipped) sized for sigma_X/a = 0.001 to 0.04 by the random law (levels whose
+/// law zeta would pass 0.6 left out); its sigma_X and energy-equivalent damping against the
+/// random law at that sigma_X, the Linear model with screens.response = Random (A_e = the
+/// model's sigma_X) on the same record, and the law's closed-form sigma_X from the excitation.
+/// Prints a Markdown table; asserts only that every run finished.
+#[test]
+#[ignore = "a report (scripts/screens-report), about a minute in a release build"]
+fn random_screens_law_report() {
+    println!(
+        "| S | sigma_X/a sized for | SWE sigma_X/a | SWE zeta_eq | law 1.880 K sigma_X | \
+         SWE / law | Linear+Random sigma_X/a | SWE / Linear | law's sigma_X from S_0, /a | SWE / that |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for s in [0.5, 0.7] {
+        let swe = screens(lab(ModelKindItem::ShallowWater), s).with(vr::SWE_CELLS, 150.0);
+        let (_, k) = law(&swe);
+        let omega = Common::read(&swe).unwrap().0.tank.fundamental().omega;
+        for level in [0.001, 0.002, 0.005, 0.01, 0.02, 0.04] {
+            let sigma = level * 0.25;
+            let zeta = RANDOM_SCREENS * k * sigma;
+            if zeta > 0.6 {
+                continue;
+            }
+            let (s0, accel) = record(omega, zeta, sigma, 1200.0);
+            let r = stationary_response(&swe, &accel, H, 10_000).expect("shallow water");
+            let at = RANDOM_SCREENS * k * r.sigma_x;
+            let linear = screens(lab(ModelKindItem::Linear), s)
+                .with(vr::MODES, 1.0)
+                .with(vr::SCREENS_RESPONSE, 2.0)
+                .with(vr::A_E, r.sigma_x);
+            let l = stationary_response(&linear, &accel, H, 10_000).expect("linear");
+            let predicted = random_screens_sigma(0.0, k, omega, s0);
+            println!(
+                "| {s} | {level} | {:.5} | {:.4} | {at:.4} | {:.3} | {:.5} | {:.3} | {:.5} | {:.3} |",
+                r.sigma_x / 0.25,
+                r.zeta_eq,
+                r.zeta_eq / at,
+                l.sigma_x / 0.25,
+                r.sigma_x / l.sigma_x,
+                predicted / 0.25,
+                r.sigma_x / predicted
+            );
+        }
     }
 }
