@@ -53,6 +53,32 @@ fn record(omega: f64, zeta: f64, sigma: f64, seconds: f64) -> (f64, Vec<f64>) {
     (s0, wind_force(s0, (0.5 * omega, 1.5 * omega), H, n, SEED))
 }
 
+/// One comparison at solidity `s`: the shallow-water model `swe` under the record sized for
+/// the rms response `sigma` (`seconds` long, the first `skip` steps not measured), the Linear
+/// model with the random law at the model's sigma_X on the same record, and the law's
+/// closed-form sigma_X from the record's density.
+struct Comparison {
+    swe: Stationary,
+    linear: Stationary,
+    predicted: f64,
+}
+
+fn compare(swe: &StartValues, s: f64, sigma: f64, seconds: f64, skip: usize) -> Comparison {
+    let (_, k) = law(swe);
+    let omega = Common::read(swe).unwrap().0.tank.fundamental().omega;
+    let (s0, accel) = record(omega, RANDOM_SCREENS * k * sigma, sigma, seconds);
+    let r = stationary_response(swe, &accel, H, skip).expect("shallow water");
+    let linear = screens(lab(ModelKindItem::Linear), s)
+        .with(vr::MODES, 1.0)
+        .with(vr::SCREENS_RESPONSE, 2.0)
+        .with(vr::A_E, r.sigma_x);
+    Comparison {
+        swe: r,
+        linear: stationary_response(&linear, &accel, H, skip).expect("linear"),
+        predicted: random_screens_sigma(0.0, k, omega, s0),
+    }
+}
+
 /// The estimator on the linear oscillator (model = Linear, one mode, damping Constant 0.05):
 /// its dissipation is c v^2 exactly, so zeta_eq is the zeta set (to the record's rounding), and
 /// its variance is the white-noise one, pi s0/(2 zeta omega^3), within the record's sampling
@@ -100,19 +126,14 @@ fn random_screens_law_matches_the_shallow_water_model() {
     let swe = screens(lab(ModelKindItem::ShallowWater), 0.5).with(vr::SWE_CELLS, 32.0);
     let (boundary, k) = law(&swe);
     assert_eq!(boundary, 0.0);
-    let omega = Common::read(&swe).unwrap().0.tank.fundamental().omega;
     for sigma in [0.001, 0.005] {
-        let zeta = RANDOM_SCREENS * k * sigma;
-        let (s0, accel) = record(omega, zeta, sigma, 400.0);
-        let r = stationary_response(&swe, &accel, H, 5000).expect("shallow water");
+        let Comparison {
+            swe: r,
+            linear: l,
+            predicted,
+        } = compare(&swe, 0.5, sigma, 400.0, 5000);
         let random = RANDOM_SCREENS * k * r.sigma_x;
         let sine = k * r.sigma_x * 2f64.sqrt();
-        let linear = screens(lab(ModelKindItem::Linear), 0.5)
-            .with(vr::MODES, 1.0)
-            .with(vr::SCREENS_RESPONSE, 2.0)
-            .with(vr::A_E, r.sigma_x);
-        let l = stationary_response(&linear, &accel, H, 5000).expect("linear");
-        let predicted = random_screens_sigma(0.0, k, omega, s0);
         eprintln!(
             "sigma {sigma}: SWE sigma_x {:.4e} (predicted {predicted:.4e}), zeta_eq {:.4}; law \
              1.880 K sigma {random:.4}, sinusoid of the same rms {sine:.4}; Linear sigma_x {:.4e}",
@@ -161,22 +182,17 @@ fn random_screens_law_report() {
     for s in [0.5, 0.7] {
         let swe = screens(lab(ModelKindItem::ShallowWater), s).with(vr::SWE_CELLS, 150.0);
         let (_, k) = law(&swe);
-        let omega = Common::read(&swe).unwrap().0.tank.fundamental().omega;
         for level in [0.001, 0.002, 0.005, 0.01, 0.02, 0.04] {
             let sigma = level * 0.25;
-            let zeta = RANDOM_SCREENS * k * sigma;
-            if zeta > 0.6 {
+            if RANDOM_SCREENS * k * sigma > 0.6 {
                 continue;
             }
-            let (s0, accel) = record(omega, zeta, sigma, 1200.0);
-            let r = stationary_response(&swe, &accel, H, 10_000).expect("shallow water");
+            let Comparison {
+                swe: r,
+                linear: l,
+                predicted,
+            } = compare(&swe, s, sigma, 1200.0, 10_000);
             let at = RANDOM_SCREENS * k * r.sigma_x;
-            let linear = screens(lab(ModelKindItem::Linear), s)
-                .with(vr::MODES, 1.0)
-                .with(vr::SCREENS_RESPONSE, 2.0)
-                .with(vr::A_E, r.sigma_x);
-            let l = stationary_response(&linear, &accel, H, 10_000).expect("linear");
-            let predicted = random_screens_sigma(0.0, k, omega, s0);
             println!(
                 "| {s} | {level} | {:.5} | {:.4} | {at:.4} | {:.3} | {:.5} | {:.3} | {:.5} | {:.3} |",
                 r.sigma_x / 0.25,
