@@ -27,7 +27,7 @@ fn random_call_sequences_keep_the_invariants() {
     let target = Target {
         value_references: VARIABLES.iter().map(|v| v.vr).collect(),
         output: vr::FORCE,
-        states: 4,
+        states: 24,
     };
     fuzz::run(target, fuzz::starting_with(model));
 }

@@ -9,24 +9,54 @@ use fmi2_slave::{Context, Continuous, EventUpdate, Refusal, Reply, Status, refus
 use super::params::output_of;
 use super::slave::Tld;
 use super::vars::{VARIABLES, VarType, index_of, vr};
-use crate::model::continuous::{Direction, STATES};
+use crate::model::continuous::{BANK, Direction, STATES};
+use crate::model::events::EVENT_INDICATORS;
+use crate::model::slamming::Event;
 use crate::model::{Damper, Unknown};
 
 /// The state derivative variables, in state order.
-const DERIVATIVES: [u32; STATES] = [
-    vr::DER_SLOSH_X_,
-    vr::DER_SLOSH_V_,
-    vr::DER_ENERGY_INPUT_,
-    vr::DER_ENERGY_DISSIPATED_,
-];
+const DERIVATIVES: [u32; STATES] = with_bank(
+    [
+        vr::DER_SLOSH_X_,
+        vr::DER_SLOSH_V_,
+        vr::DER_ENERGY_INPUT_,
+        vr::DER_ENERGY_DISSIPATED_,
+        vr::DER_IMPACT_Z_,
+        vr::DER_IMPACT_V_,
+    ],
+    2,
+);
 
 /// The continuous state variables, in state order.
-const STATE_VARIABLES: [u32; STATES] = [
-    vr::SLOSH_X,
-    vr::SLOSH_V,
-    vr::ENERGY_INPUT,
-    vr::ENERGY_DISSIPATED,
-];
+const STATE_VARIABLES: [u32; STATES] = with_bank(
+    [
+        vr::SLOSH_X,
+        vr::SLOSH_V,
+        vr::ENERGY_INPUT,
+        vr::ENERGY_DISSIPATED,
+        vr::IMPACT_Z,
+        vr::IMPACT_V,
+    ],
+    0,
+);
+
+/// `first`, then the Linear model's bank mode[n].x, mode[n].v (n = 2, 3, ...), whose value
+/// references run four a mode from mode[2].x's (x, v, der(x), der(v)): `offset` 2 gives the
+/// derivatives. The tests check every name.
+const fn with_bank(first: [u32; BANK], offset: u32) -> [u32; STATES] {
+    let mut out = [0; STATES];
+    let mut k = 0;
+    while k < STATES {
+        out[k] = if k < BANK {
+            first[k]
+        } else {
+            let (mode, which) = ((k - BANK) / 2, (k - BANK) % 2);
+            vr::MODE_2__X + 4 * mode as u32 + which as u32 + offset
+        };
+        k += 1;
+    }
+    out
+}
 
 /// The direction the host gives as changes `dv` of the states and inputs `knowns`.
 fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
@@ -41,8 +71,9 @@ fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
                 None => {
                     return Err(refuse(format!(
                         "fmi2GetDirectionalDerivative: value reference {r} is neither a \
-                         continuous state (slosh.x, slosh.v, energy.input, energy.dissipated) nor \
-                         an input (base.a, base.v, base.x)"
+                         continuous state (slosh.x, slosh.v, energy.input, energy.dissipated, \
+                         impact.z, impact.v, mode[n].x, mode[n].v) nor an input (base.a, base.v, \
+                         base.x)"
                     )));
                 }
             },
@@ -95,31 +126,42 @@ impl Tld {
 }
 
 impl Tld {
-    /// The value of a state derivative variable (der(slosh.x), ...), if `r` names one.
+    /// The value of a state derivative variable (der(slosh.x), ...) or of a state that is no
+    /// output (impact.v), if `r` names one.
     pub(super) fn derivative_value(
         &self,
         context: &Context,
         r: u32,
     ) -> Option<Result<f64, Refusal>> {
-        let k = DERIVATIVES.iter().position(|&d| d == r)?;
+        // Ok(k): the derivative of state k; Err(k): state k.
+        let which = match DERIVATIVES.iter().position(|&d| d == r) {
+            Some(k) => Ok(k),
+            None => Err(STATE_VARIABLES.iter().position(|&s| s == r)?),
+        };
         // Before initialisation (hosts read the initial unknowns in initialisation mode): from
         // the simulation the parameters set so far would start.
         let mut provisional = None;
         let inputs = self.values.inputs([0.0; 2]);
         Some(
             self.simulation(context, &mut provisional)
-                .map(|sim| sim.continuous_derivatives(&inputs)[k]),
+                .map(|sim| match which {
+                    Ok(k) => sim.continuous_derivatives(&inputs)[k],
+                    Err(k) => sim.continuous_states()[k],
+                }),
         )
     }
 }
 
 impl Continuous for Tld {
     const STATES: usize = STATES;
+    const EVENT_INDICATORS: usize = EVENT_INDICATORS;
     const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
-        "Model Exchange offers model = Linear (modes = 1), Nonlinear and Auto; the states are \
-         slosh.x, slosh.v, energy.input, energy.dissipated. amplitude = Tracked samples base.a \
-         and base.v at time events, 100 per natural sloshing period. SloshingSlamming and \
-         ShallowWater are Co-Simulation only (fmi2ExitInitializationMode says why); see \
+        "Model Exchange offers model = Linear (modes <= 10), Nonlinear, Auto and \
+         SloshingSlamming (impacts as state events); the states are slosh.x, slosh.v, \
+         energy.input, energy.dissipated, impact.z, impact.v and mode[n].x, mode[n].v (n = \
+         2..10, Linear's higher modes). amplitude = Tracked samples base.a and base.v at time \
+         events, 100 per natural sloshing period. ShallowWater and Linear with more modes are \
+         Co-Simulation only (fmi2ExitInitializationMode says why); see \
          docs/MODEL_EXCHANGE.md",
     );
 
@@ -164,16 +206,32 @@ impl Continuous for Tld {
         )
     }
 
-    /// The tracked amplitude's samples are time events (none for a fixed amplitude); the
-    /// continuous states never change at an event.
+    fn event_indicators(&self, context: &Context, out: &mut [f64]) -> Reply {
+        let inputs = self.values.inputs([0.0; 2]);
+        let z = self
+            .running("fmi2GetEventIndicators")?
+            .event_indicators(&inputs);
+        copy_finite(
+            "fmi2GetEventIndicators",
+            "event indicator",
+            context,
+            inputs.a,
+            &z,
+            out,
+        )
+    }
+
+    /// An impact (state event) and the tracked amplitude's samples (time events; none for a
+    /// fixed amplitude).
     fn event_update(&mut self, context: &Context) -> Result<EventUpdate, Refusal> {
         let inputs = self.values.inputs([0.0; 2]);
         let sim = self
             .sim
             .as_mut()
             .ok_or_else(|| refuse("fmi2NewDiscreteStates: no simulation (not initialised)"))?;
+        let event = sim.event(&inputs);
         Ok(EventUpdate {
-            states_changed: false,
+            states_changed: matches!(event, Event::Impact { .. }),
             next_event: sim.amplitude_event(context.experiment.start, context.time, &inputs),
         })
     }
@@ -207,5 +265,36 @@ impl Continuous for Tld {
         sim.directional_derivatives(&inputs, &d, &unknowns, &mut out)
             .map_err(|why| refuse(format!("{F}: {why}")))?;
         copy_finite(F, "entry", context, inputs.a, &out, dv_unknown)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn name(r: u32) -> &'static str {
+        index_of(r).map_or("?", |k| VARIABLES[k].name)
+    }
+
+    /// The bank's value references name mode[n].x, mode[n].v and their derivatives.
+    #[test]
+    fn the_bank_names_its_modes() {
+        for k in BANK..STATES {
+            let n = 2 + (k - BANK) / 2;
+            let which = if (k - BANK).is_multiple_of(2) {
+                "x"
+            } else {
+                "v"
+            };
+            let state = format!("mode[{n}].{which}");
+            assert_eq!(name(STATE_VARIABLES[k]), state);
+            assert_eq!(name(DERIVATIVES[k]), format!("der({state})"));
+        }
+        for k in 0..BANK {
+            assert_eq!(
+                name(DERIVATIVES[k]),
+                format!("der({})", name(STATE_VARIABLES[k]))
+            );
+        }
     }
 }

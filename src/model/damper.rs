@@ -361,6 +361,7 @@ fn per_step(model: &AnyModel) -> [f64; 3] {
 }
 
 mod continuous;
+mod events;
 pub use continuous::Unknown;
 
 #[cfg(test)]
