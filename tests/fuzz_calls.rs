@@ -17,7 +17,7 @@ fn random_call_sequences_keep_the_invariants() {
         .iter()
         .map(|m| m.value() as i32)
         .collect();
-    // amplitude Fixed (1) or Tracked (2), in Co-Simulation and in Model Exchange.
+    // amplitude Fixed (1) or Tracked (2): Model Exchange runs with Fixed only.
     let model = (proptest::sample::select(models), 1..=2i32).prop_map(|(model, amplitude)| {
         Call::SetInteger {
             vrs: vec![vr::MODEL, vr::AMPLITUDE],

@@ -176,110 +176,10 @@ fn a_model_not_offered_says_why_and_another_can_be_chosen() {
     assert_eq!(inst.derivatives(N).0, ERROR);
     assert_eq!(inst.set_integer(vr::MODEL, NONLINEAR), OK);
     assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
-}
-
-/// The default parameters (Nonlinear, NSD damping, amplitude Tracked) in ME, out of
-/// initialisation into the first event: the tracker's first sample at the start, and the next
-/// one a time event 1/100 of the natural sloshing period later.
-fn tracked_running(name: &str) -> (Instance, f64) {
-    let inst = Instance::model_exchange(name);
-    assert_eq!(inst.setup(), OK);
-    assert_eq!(inst.enter(), OK);
-    assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
-    let h = std::f64::consts::TAU / (inst.real(vr::OMEGA_F) * 100.0);
-    (inst, h)
-}
-
-/// Base motion of the tracked runs: a(t), v(t) of a 2 mm harmonic at 5.5 rad/s (the tracker's
-/// prior is A_e = 5 mm).
-fn harmonic(t: f64) -> (f64, f64) {
-    let (w, amp) = (5.5, 0.002);
-    (-w * w * amp * (w * t).sin(), w * amp * (w * t).cos())
-}
-
-/// One event of an ME host at time `t`: the inputs sampled at t, fmi2NewDiscreteStates;
-/// returns the next event time.
-fn event_at(inst: &Instance, t: f64) -> f64 {
-    let (a, v) = harmonic(t);
-    assert_eq!(inst.set_real(vr::BASE_A, a), OK);
-    assert_eq!(inst.set_real(vr::BASE_V, v), OK);
-    let (s, info) = inst.new_discrete_states();
-    assert_eq!(
-        (s, info.newDiscreteStatesNeeded),
-        (OK, 0),
-        "{:?}",
-        inst.logs()
-    );
-    assert_eq!(info.valuesOfContinuousStatesChanged, 0);
-    assert_eq!(info.nextEventTimeDefined, 1);
-    info.nextEventTime
-}
-
-/// From the event at `t` to the next (its inputs held, as a Co-Simulation step holds them),
-/// by RK4 in 10 steps; returns the next event time.
-fn to_next_event(inst: &Instance, t: f64, next: f64) -> f64 {
-    assert_eq!(inst.enter_continuous_time_mode(), OK);
-    let (a, v) = harmonic(t);
-    inst.rk4(N, t, next, 10, |i, _| {
-        assert_eq!(i.set_real(vr::BASE_A, a), OK);
-        assert_eq!(i.set_real(vr::BASE_V, v), OK);
-    });
-    assert_eq!(inst.enter_event_mode(), OK);
-    event_at(inst, next)
-}
-
-/// amplitude = Tracked in ME is the Co-Simulation tracker sampled at time events: with the
-/// same samples (held inputs, communication step = the sample period), A_e.estimate and
-/// zeta.effective equal Co-Simulation's after every sample, and the motion agrees to the
-/// integrators' accuracy (ME: the host's RK4 at h/10; CS: DormandPrince45 at 1e-12) over
-/// 450 samples (5 s), while the estimate moves far from its prior and the damping with it.
-#[test]
-fn a_tracked_amplitude_is_sampled_at_time_events_as_co_simulation_steps_are() {
-    let (me, h) = tracked_running("me-tracked");
-    let mut cs = Instance::new("cs-tracked");
-    assert_eq!(cs.setup(), OK);
-    assert_eq!(cs.enter(), OK);
-    assert_eq!(cs.set_real(vr::SOLVER_TOLERANCE, 1e-12), OK);
-    assert_eq!(cs.exit(), OK);
-    let prior = (me.real(vr::A_E_ESTIMATE), me.real(vr::ZETA_EFFECTIVE));
-    let mut next = event_at(&me, 0.0);
-    assert!((next - h).abs() < 1e-15, "{next} vs {h}");
-    let (mut t, mut peak, mut worst) = (0.0, 0.0f64, 0.0f64);
-    for k in 0..450 {
-        let (a, v) = harmonic(t);
-        assert_eq!(cs.set_real(vr::BASE_A, a), OK);
-        assert_eq!(cs.set_real(vr::BASE_V, v), OK);
-        // CS takes the sample at the start of its step, ME at the event that starts it.
-        assert_eq!(cs.do_step(h), OK, "{:?}", cs.logs());
-        let after = next;
-        next = to_next_event(&me, t, next);
-        t = after;
-        assert!(
-            (next - (k + 2) as f64 * h).abs() < 1e-12,
-            "{next} at sample {k}"
-        );
-        let (xm, xc) = (me.real(vr::SLOSH_X), cs.real(vr::SLOSH_X));
-        peak = peak.max(xc.abs());
-        worst = worst.max((xm - xc).abs());
-    }
-    // ME took the sample at t at its event; CS takes it with its next step.
-    let (a, v) = harmonic(t);
-    assert_eq!(cs.set_real(vr::BASE_A, a), OK);
-    assert_eq!(cs.set_real(vr::BASE_V, v), OK);
-    assert_eq!(cs.do_step(h), OK);
-    for r in [vr::A_E_ESTIMATE, vr::ZETA_EFFECTIVE] {
-        let (m, c) = (me.real(r), cs.real(r));
-        assert!((m - c).abs() <= 1e-15 * c.abs(), "{r}: ME {m} vs CS {c}");
-    }
-    let now = (me.real(vr::A_E_ESTIMATE), me.real(vr::ZETA_EFFECTIVE));
-    assert!(
-        (now.0 - 0.002).abs() < 0.1 * 0.002 && (now.1 - prior.1).abs() > 0.1 * prior.1,
-        "{prior:?} -> {now:?}"
-    );
-    assert!(
-        peak > 0.005 && worst < 1e-9 * peak,
-        "slosh.x ME vs CS {worst:e} of {peak}"
-    );
+    let tracked = in_initialisation("me-tracked", NONLINEAR, 0.0);
+    assert_eq!(tracked.set_integer(vr::AMPLITUDE, 2), OK);
+    assert_eq!(tracked.exit(), ERROR);
+    assert!(tracked.logs().join("\n").contains("amplitude = Tracked"));
 }
 
 /// An FMU state saved in continuous-time mode restores (in this and in a new ME instance, from
@@ -359,49 +259,8 @@ fn instantiating_for_model_exchange_says_what_is_offered() {
     for part in [
         "Linear (modes <= 10)",
         "SloshingSlamming (impacts as state events)",
-        "amplitude = Tracked samples base.a",
-        "ShallowWater and Linear with more modes are Co-Simulation only",
+        "ShallowWater, Linear with more modes and amplitude = Tracked",
     ] {
         assert!(said.contains(part), "no '{part}' in: {said}");
     }
-}
-
-/// A state saved in continuous-time mode right after a sample's event restores with that
-/// sample taken (the samples are not saved; the time and the phase say how many were due): an
-/// input event half a sample period later takes no sample (A_e.estimate unchanged) and says
-/// the next sample's time, in the instance and in a new one restored from the bytes.
-#[test]
-fn a_restored_tracked_instance_takes_each_sample_once() {
-    let (me, h) = tracked_running("me-tracked-save");
-    let mut next = event_at(&me, 0.0);
-    let mut t = 0.0;
-    for _ in 0..20 {
-        let after = next;
-        next = to_next_event(&me, t, next);
-        t = after;
-    }
-    assert_eq!(me.enter_continuous_time_mode(), OK);
-    let bytes = me.serialised();
-    let (other, _) = tracked_running("me-tracked-restored");
-    let mut s = restore(&other, &bytes);
-    for inst in [&me, &other] {
-        let estimate = inst.real(vr::A_E_ESTIMATE);
-        let (a, v) = harmonic(t);
-        inst.rk4(N, t, t + 0.5 * h, 5, |i, _| {
-            assert_eq!(i.set_real(vr::BASE_A, a), OK);
-            assert_eq!(i.set_real(vr::BASE_V, v), OK);
-        });
-        assert_eq!(inst.enter_event_mode(), OK);
-        assert_eq!(inst.set_real(vr::BASE_A, 1.0), OK);
-        let (st, info) = inst.new_discrete_states();
-        assert_eq!(
-            (st, info.nextEventTimeDefined),
-            (OK, 1),
-            "{:?}",
-            inst.logs()
-        );
-        assert_eq!(info.nextEventTime, next);
-        assert_eq!(inst.real(vr::A_E_ESTIMATE), estimate);
-    }
-    assert_eq!(unsafe { other.lib.fmi2FreeFMUstate(other.c, &mut s) }, OK);
 }

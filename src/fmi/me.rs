@@ -157,11 +157,10 @@ impl Continuous for Tld {
     const EVENT_INDICATORS: usize = EVENT_INDICATORS;
     const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
         "Model Exchange offers model = Linear (modes <= 10), Nonlinear, Auto and \
-         SloshingSlamming (impacts as state events); the states are slosh.x, slosh.v, \
-         energy.input, energy.dissipated, impact.z, impact.v and mode[n].x, mode[n].v (n = \
-         2..10, Linear's higher modes). amplitude = Tracked samples base.a and base.v at time \
-         events, 100 per natural sloshing period. ShallowWater and Linear with more modes are \
-         Co-Simulation only (fmi2ExitInitializationMode says why); see \
+         SloshingSlamming (impacts as state events) with amplitude = Fixed; the states are \
+         slosh.x, slosh.v, energy.input, energy.dissipated, impact.z, impact.v and mode[n].x, \
+         mode[n].v (n = 2..10, Linear's higher modes). ShallowWater, Linear with more modes and \
+         amplitude = Tracked are Co-Simulation only (fmi2ExitInitializationMode says why); see \
          docs/MODEL_EXCHANGE.md",
     );
 
@@ -221,9 +220,7 @@ impl Continuous for Tld {
         )
     }
 
-    /// An impact (state event) and the tracked amplitude's samples (time events; none for a
-    /// fixed amplitude).
-    fn event_update(&mut self, context: &Context) -> Result<EventUpdate, Refusal> {
+    fn event_update(&mut self, _: &Context) -> Result<EventUpdate, Refusal> {
         let inputs = self.values.inputs([0.0; 2]);
         let sim = self
             .sim
@@ -232,7 +229,7 @@ impl Continuous for Tld {
         let event = sim.event(&inputs);
         Ok(EventUpdate {
             states_changed: matches!(event, Event::Impact { .. }),
-            next_event: sim.amplitude_event(context.experiment.start, context.time, &inputs),
+            next_event: None,
         })
     }
 

@@ -20,7 +20,6 @@
 //! All numbers little-endian.
 
 use fmi2_slave::Context;
-use fmi2_slave::calls::Phase;
 use fmi2_slave::frame::{Reader, put_f64, put_f64_list};
 
 use super::params::{Configuration, Values};
@@ -58,15 +57,7 @@ impl Tld {
                 tolerance: context.experiment.tolerance,
                 user_tolerance,
             };
-            let mut sim = Damper::restore(&configuration, &simulation)?;
-            // Model Exchange's amplitude samples follow from the time; in event mode the
-            // event's own sample is still to come (fmi2NewDiscreteStates takes it).
-            sim.resume_amplitude_samples(
-                context.experiment.start,
-                context.time,
-                context.phase == Phase::ContinuousTimeMode,
-            );
-            Some(sim)
+            Some(Damper::restore(&configuration, &simulation)?)
         } else if simulation.is_empty() {
             None
         } else {

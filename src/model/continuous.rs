@@ -15,8 +15,8 @@
 //! parameter); Linear with more than [`ME_MODES`] modes.
 //!
 //! Directional derivatives (J d, for a host's implicit solver): the exact derivatives of the
-//! same rates in the states and the base acceleration, the damping ratio constant (a fixed
-//! amplitude, or a tracked one between its samples), from the oscillator's restoring force f(x) and its slope f'(x) (Phi of Eq 2.13 and
+//! same rates in the states and the base acceleration, the damping ratio fixed (amplitude =
+//! Fixed), from the oscillator's restoring force f(x) and its slope f'(x) (Phi of Eq 2.13 and
 //! dPhi/dx; finite at x = 0 for every eta >= 1).
 //!
 //! [`Model::rate`]: super::Model::rate
@@ -48,9 +48,8 @@ pub const RATES: [Output; 4] = [
 pub struct Direction {
     /// Changes of [x, v, energy.input, energy.dissipated].
     pub states: [f64; STATES],
-    /// Changes of the inputs base.a [m/s^2], base.v [m/s], base.x [m]. No continuous equation
-    /// reads base.v or base.x (a tracked amplitude reads base.v at its samples only): their
-    /// columns of J are 0.
+    /// Changes of the inputs base.a [m/s^2], base.v [m/s], base.x [m]. With amplitude = Fixed
+    /// no equation reads base.v or base.x: their columns of J are 0.
     pub a: f64,
     pub v: f64,
     pub x: f64,

@@ -38,9 +38,6 @@ pub struct Damper {
     per_step: [f64; 3],
     /// Whether the run has been told of implausible motion.
     noticed: bool,
-    /// Model Exchange with a tracked amplitude: the samples the tracker has taken (the next is
-    /// due at the start plus this many sample periods; `Damper::amplitude_event`).
-    samples: u64,
 }
 
 /// What a step of the damper reports besides its new state.
@@ -93,7 +90,6 @@ impl Damper {
             zeta,
             last_mean_force: None,
             noticed: false,
-            samples: 0,
         };
         Ok((damper, warnings))
     }

@@ -1,23 +1,12 @@
 //! The damper in Model Exchange: the model's continuous states (see `model::continuous`) with
 //! what the damper adds around them, the energy at the start (counted as input) and the damping
-//! law. A fixed amplitude keeps the damping ratio constant. A tracked one (amplitude = Tracked)
-//! is the Co-Simulation filter sampled at time events instead of communication steps:
-//! [`SAMPLES_PER_PERIOD`] samples of base.a and base.v per natural sloshing period, each
-//! setting the damping ratio until the next (constant between events, so the states'
-//! equations and their Jacobian are those of a fixed amplitude).
+//! law. The damping ratio is constant in Model Exchange: amplitude = Fixed. The online amplitude
+//! estimate (amplitude = Tracked) is a sampled filter of the host's communication steps, and a
+//! host's solver has none; it is refused with that reason.
 
 use super::{Damper, per_step};
 use crate::model::continuous::{BANK, Direction, IMPACT_V, IMPACT_Z, STATES, Tangent};
-use crate::model::{Inputs, Output};
-
-/// Model Exchange samples a tracked amplitude this many times per natural sloshing period
-/// (the period of omega_f): about the Co-Simulation's default 10 ms step for the lab tank
-/// (T = 1.11 s), and as many samples per period for any tank.
-pub const SAMPLES_PER_PERIOD: f64 = 100.0;
-
-/// A host's event time is the time it was told within rounding: a sample is due from this
-/// fraction of a sample period before its time.
-const DUE_WITHIN: f64 = 1e-9;
+use crate::model::{AmplitudeSource, Inputs, Output};
 
 /// What a directional derivative asks for: a state's derivative (in state order) or an output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,55 +18,16 @@ pub enum Unknown {
 impl Damper {
     /// Ok if a host's solver can integrate this damper; Err: why not.
     pub fn offers_model_exchange(&self) -> Result<(), String> {
-        self.model.offers_model_exchange()
-    }
-
-    /// The tracked amplitude's sample period in Model Exchange [s]; None for a fixed one.
-    pub fn amplitude_sample_period(&self) -> Option<f64> {
-        self.tracker
-            .as_ref()
-            .map(|_| std::f64::consts::TAU / (self.derived.omega_f * SAMPLES_PER_PERIOD))
-    }
-
-    /// The event at time `t` of a run that started at `start`: if a sample of the tracked
-    /// amplitude is due, the tracker takes in the inputs now (as a Co-Simulation step from `t`
-    /// of one sample period would) and the damping ratio follows its estimate until the next.
-    /// Returns the time of the next sample; None for a fixed amplitude (no time events). A host
-    /// that stepped over due samples gets one sample now and the next after `t`.
-    pub fn amplitude_event(&mut self, start: f64, t: f64, inputs: &Inputs) -> Option<f64> {
-        let h = self.amplitude_sample_period()?;
-        let due = |k: u64| start + k as f64 * h;
-        if t >= due(self.samples) - DUE_WITHIN * h {
-            if let Some(tracker) = self.tracker.as_mut() {
-                tracker.update(h, inputs.a, inputs.v);
-            }
-            // Samples whose times lie at or before t: the one just taken and any skipped.
-            let at_or_before = ((t - start) / h + DUE_WITHIN).floor().max(0.0) as u64 + 1;
-            self.samples = at_or_before.max(self.samples + 1);
-            if self.damping_reads_amplitude {
-                self.zeta = self.common.zeta(self.amplitude());
-                self.model.set_damping(self.zeta);
-            }
+        self.model.offers_model_exchange()?;
+        if let AmplitudeSource::Tracked { .. } = self.common.amplitude {
+            return Err(
+                "amplitude = Tracked estimates A_e by a filter sampled at the communication \
+                 steps, which Model Exchange does not have: set amplitude = Fixed (the damping \
+                 law then uses A_e), or use Co-Simulation"
+                    .into(),
+            );
         }
-        Some(due(self.samples))
-    }
-
-    /// After a restore at time `t` (the samples are not saved: the time says how many were
-    /// due): every sample before `t` taken, and the one at `t`, if `t` is a sample time, only
-    /// if `taken_at_t` (a state saved in continuous-time mode, after the event).
-    pub fn resume_amplitude_samples(&mut self, start: f64, t: f64, taken_at_t: bool) {
-        let Some(h) = self.amplitude_sample_period() else {
-            return;
-        };
-        let position = (t - start) / h;
-        let last = (position + DUE_WITHIN).floor();
-        if last < 0.0 {
-            self.samples = 0;
-            return;
-        }
-        // last = floor(position + DUE_WITHIN): position - last lies in [-DUE_WITHIN, 1).
-        let at_sample = position - last < DUE_WITHIN;
-        self.samples = last as u64 + u64::from(!at_sample || taken_at_t);
+        Ok(())
     }
 
     /// The continuous states [slosh.x, slosh.v, energy.input, energy.dissipated, impact.z,
@@ -131,7 +81,7 @@ impl Damper {
     }
 
     /// J d: the exact change of each of `unknowns` for the change `d` of the states and inputs
-    /// (the damping ratio changes at events only, not with them), into `out`. Err, and
+    /// (amplitude = Fixed, so the damping ratio does not change with them), into `out`. Err, and
     /// `out` untouched, for a damper not offered in Model Exchange or an unknown out of range.
     pub fn directional_derivatives(
         &self,
@@ -178,8 +128,7 @@ impl Damper {
             Output::EnergyDissipated => d.states[3],
             Output::EnergyStored => stored,
             Output::ImpactZ => impact_z,
-            // Amplitude and damping change at events only, not with the states; so does the
-            // count of impacts.
+            // Fixed amplitude and damping; the count of impacts changes at events only.
             Output::Amplitude | Output::Zeta | Output::Impacts => 0.0,
             Output::SurfaceLeft | Output::SurfaceRight => {
                 if self.model.surface().is_some() {
