@@ -60,6 +60,26 @@ impl Access for Booleans {
     }
 }
 
+/// Our instance behind `c` if `call` passes quietly on it (its phase allows the call, no call
+/// logging) with `n` > 0 values in valid host arrays `vr` and `value`: what the quick paths of
+/// `get` and `set` assume.
+///
+/// # Safety
+/// `c` as for [`Instance::from_ptr`].
+#[inline(always)]
+unsafe fn quiet<'a, S: Slave, R, V>(
+    c: fmi2Component,
+    call: &Call,
+    vr: *const R,
+    n: usize,
+    value: *const V,
+) -> Option<&'a mut Instance<S>> {
+    // SAFETY: per the contract above.
+    let inst = unsafe { Instance::<S>::from_ptr(c) }?;
+    let quiet = n > 0 && inst.passes_quietly(call) && valid_array(vr, n) && valid_array(value, n);
+    quiet.then_some(inst)
+}
+
 /// fmi2Get{Real,Integer,Boolean}: the quick path ([`Slave::get_quietly`]) when every value is
 /// a load and the call passes quietly, else the full one. The quick path needs no saved
 /// registers and no reply to carry: the full one is a call away.
@@ -71,13 +91,8 @@ unsafe fn get<S: Slave, A: Access>(
     nvr: usize,
     value: *mut A::Host,
 ) -> fmi2Status {
-    // SAFETY: `c` is what the host passed as our component; from_ptr accepts only our mark.
-    if let Some(inst) = unsafe { Instance::<S>::from_ptr(c) }
-        && nvr > 0
-        && inst.passes_quietly(call)
-        && valid_array(vr, nvr)
-        && valid_array(value, nvr)
-    {
+    // SAFETY: the host's component and arrays, checked there.
+    if let Some(inst) = unsafe { quiet::<S, _, _>(c, call, vr, nvr, value) } {
         // SAFETY: host arrays of nvr elements, checked above.
         let (vrs, out) = unsafe {
             (
@@ -138,11 +153,8 @@ unsafe fn set<S: Slave, A: Access>(
     value: *const A::Host,
 ) -> fmi2Status {
     // SAFETY: as in `get`.
-    if let Some(inst) = unsafe { Instance::<S>::from_ptr(c) }
-        && nvr == 1
-        && inst.passes_quietly(call)
-        && valid_array(vr, 1)
-        && valid_array(value, 1)
+    if nvr == 1
+        && let Some(inst) = unsafe { quiet::<S, _, _>(c, call, vr, nvr, value) }
     {
         // SAFETY: host arrays of one element, checked above.
         let (r, v) = unsafe { (*vr, A::from_host(*value)) };
