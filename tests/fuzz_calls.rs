@@ -27,7 +27,8 @@ fn random_call_sequences_keep_the_invariants() {
     let target = Target {
         value_references: VARIABLES.iter().map(|v| v.vr).collect(),
         output: vr::FORCE,
-        states: 4,
+        states: tld_fmu::model::continuous::STATES
+            + tld_fmu::model::shallow_water::continuous::CELL_STATES,
     };
     fuzz::run(target, fuzz::starting_with(model));
 }

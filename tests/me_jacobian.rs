@@ -12,6 +12,8 @@ use common::*;
 use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType, vr};
 
 const N: usize = 4;
+/// All continuous states: the four, then the ShallowWater cell bank (0 for these models).
+const ALL: usize = N + tld_fmu::model::shallow_water::continuous::CELL_STATES;
 const LINEAR: i32 = 1;
 const NONLINEAR: i32 = 2;
 const AUTO: i32 = 4;
@@ -84,15 +86,18 @@ fn column(inst: &Instance, known: u32) -> Vec<f64> {
 
 /// The unknowns' values: the derivatives, then the outputs.
 fn values(inst: &Instance) -> Vec<f64> {
-    let (s, mut out) = inst.derivatives(N);
+    let (s, mut out) = inst.derivatives(ALL);
     assert_eq!(s, OK, "{:?}", inst.logs());
+    out.truncate(N);
     out.extend(outputs().into_iter().map(|r| inst.real(r)));
     out
 }
 
 /// Set the states and inputs `p` (KNOWNS' order).
 fn put(inst: &Instance, p: &[f64; 7]) {
-    assert_eq!(inst.set_states(&p[..N]), OK, "{:?}", inst.logs());
+    let mut x = vec![0.0; ALL];
+    x[..N].copy_from_slice(&p[..N]);
+    assert_eq!(inst.set_states(&x), OK, "{:?}", inst.logs());
     for (k, &r) in KNOWNS.iter().enumerate().skip(N) {
         assert_eq!(inst.set_real(r, p[k]), OK);
     }

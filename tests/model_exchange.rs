@@ -8,8 +8,17 @@ mod common;
 use common::*;
 use tld_fmu::fmi::vars::vr;
 
-/// Continuous states of TLD.fmu in ME: slosh.x, slosh.v, energy.input, energy.dissipated.
-const N: usize = 4;
+/// Continuous states of TLD.fmu in ME: slosh.x, slosh.v, energy.input, energy.dissipated, then
+/// the ShallowWater cell bank (all 0 for the other models).
+const N: usize =
+    tld_fmu::model::continuous::STATES + tld_fmu::model::shallow_water::continuous::CELL_STATES;
+
+/// The four states `core` and the cell bank at 0.
+fn padded(core: [f64; 4]) -> Vec<f64> {
+    let mut x = vec![0.0; N];
+    x[..4].copy_from_slice(&core);
+    x
+}
 /// Items: model = Linear (1), Nonlinear (2), SloshingSlamming (3); damping Constant (1);
 /// amplitude Fixed (1).
 const LINEAR: i32 = 1;
@@ -124,8 +133,8 @@ fn calls_out_of_order_say_what_to_call_first() {
     assert_eq!(me.new_discrete_states().0, ERROR);
     // Wrong array lengths, and a non-finite state.
     assert_eq!(me.derivatives(N + 1).0, ERROR);
-    assert_eq!(me.set_states(&[0.0, f64::NAN, 0.0, 0.0]), ERROR);
-    assert_eq!(me.set_states(&[1e6, 0.0, 0.0, 0.0]), ERROR);
+    assert_eq!(me.set_states(&padded([0.0, f64::NAN, 0.0, 0.0])), ERROR);
+    assert_eq!(me.set_states(&padded([1e6, 0.0, 0.0, 0.0])), ERROR);
     let (_, x) = me.states(N);
     assert_eq!(
         x, [0.0; N],
@@ -250,7 +259,8 @@ fn instantiating_for_model_exchange_says_what_is_offered() {
     let said = logs_of("me-note").join("\n");
     for part in [
         "Linear (modes = 1)",
-        "SloshingSlamming, ShallowWater and amplitude = Tracked",
+        "ShallowWater (swe.cells <= 200)",
+        "SloshingSlamming and amplitude = Tracked",
     ] {
         assert!(said.contains(part), "no '{part}' in: {said}");
     }

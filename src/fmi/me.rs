@@ -6,11 +6,17 @@
 
 use fmi2_slave::{Context, Continuous, Refusal, Reply, Status, refuse};
 
+use super::me_cells::{Cell, cell_of};
+
 use super::params::output_of;
 use super::slave::Tld;
 use super::vars::{VARIABLES, VarType, index_of, vr};
 use crate::model::continuous::{Direction, STATES};
+use crate::model::shallow_water::continuous::{CELL_STATES, CellRefusal};
 use crate::model::{Damper, Unknown};
+
+/// All continuous states: the four of every offered model, then the ShallowWater cell bank.
+const ALL_STATES: usize = STATES + CELL_STATES;
 
 /// The state derivative variables, in state order.
 const DERIVATIVES: [u32; STATES] = [
@@ -38,6 +44,9 @@ fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
             vr::BASE_X => &mut d.x,
             _ => match STATE_VARIABLES.iter().position(|&s| s == r) {
                 Some(k) => &mut d.states[k],
+                // A cell: no equation of a model without cells reads it (and a model with cells
+                // has no directional derivatives).
+                None if matches!(cell_of(r), Some(Cell::State(_))) => continue,
                 None => {
                     return Err(refuse(format!(
                         "fmi2GetDirectionalDerivative: value reference {r} is neither a \
@@ -56,6 +65,9 @@ fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
 fn unknown(r: u32) -> Result<Unknown, Refusal> {
     if let Some(k) = DERIVATIVES.iter().position(|&d| d == r) {
         return Ok(Unknown::Derivative(k));
+    }
+    if let Some(Cell::Derivative(_)) = cell_of(r) {
+        return Ok(Unknown::Frozen);
     }
     let real = index_of(r).is_some_and(|k| VARIABLES[k].ty == VarType::Real);
     match output_of(r) {
@@ -95,13 +107,16 @@ impl Tld {
 }
 
 impl Tld {
-    /// The value of a state derivative variable (der(slosh.x), ...), if `r` names one.
+    /// The value of a state derivative variable (der(slosh.x), ...) or of a cell's state or
+    /// derivative, if `r` names one.
     pub(super) fn derivative_value(
         &self,
         context: &Context,
         r: u32,
     ) -> Option<Result<f64, Refusal>> {
-        let k = DERIVATIVES.iter().position(|&d| d == r)?;
+        let Some(k) = DERIVATIVES.iter().position(|&d| d == r) else {
+            return self.cell_value(context, cell_of(r)?);
+        };
         // Before initialisation (hosts read the initial unknowns in initialisation mode): from
         // the simulation the parameters set so far would start.
         let mut provisional = None;
@@ -113,13 +128,36 @@ impl Tld {
     }
 }
 
+impl Tld {
+    /// A cell's state or derivative (0 for a model without cells).
+    fn cell_value(&self, context: &Context, cell: Cell) -> Option<Result<f64, Refusal>> {
+        let mut provisional = None;
+        let inputs = self.values.inputs([0.0; 2]);
+        let mut bank = [0.0; CELL_STATES];
+        Some(
+            self.simulation(context, &mut provisional)
+                .map(|sim| match cell {
+                    Cell::State(k) => {
+                        sim.cell_states(&mut bank);
+                        bank[k]
+                    }
+                    Cell::Derivative(k) => {
+                        sim.cell_derivatives(&inputs, &mut bank);
+                        bank[k]
+                    }
+                }),
+        )
+    }
+}
+
 impl Continuous for Tld {
-    const STATES: usize = STATES;
+    const STATES: usize = ALL_STATES;
     const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
-        "Model Exchange offers model = Linear (modes = 1), Nonlinear and Auto with amplitude = \
-         Fixed; the states are slosh.x, slosh.v, energy.input, energy.dissipated. \
-         SloshingSlamming, ShallowWater and amplitude = Tracked are Co-Simulation only \
-         (fmi2ExitInitializationMode says why); see docs/MODEL_EXCHANGE.md",
+        "Model Exchange offers model = Linear (modes = 1), Nonlinear, Auto and ShallowWater \
+         (swe.cells <= 200) with amplitude = Fixed; the states are slosh.x, slosh.v, \
+         energy.input, energy.dissipated, then the ShallowWater cells swe.h[i], swe.q[i] (frozen \
+         at 0 for the other models). SloshingSlamming and amplitude = Tracked are Co-Simulation \
+         only (fmi2ExitInitializationMode says why); see docs/MODEL_EXCHANGE.md",
     );
 
     fn offers_model_exchange(&self) -> Result<(), String> {
@@ -129,30 +167,43 @@ impl Continuous for Tld {
     }
 
     fn states(&self, x: &mut [f64]) -> Reply {
-        x.copy_from_slice(&self.running("fmi2GetContinuousStates")?.continuous_states());
+        let sim = self.running("fmi2GetContinuousStates")?;
+        let (core, cells) = split(x);
+        core.copy_from_slice(&sim.continuous_states());
+        sim.cell_states(cells);
         Ok(Status::Ok)
     }
 
     fn set_states(&mut self, _: &Context, x: &[f64]) -> Reply {
         let mut s = [0.0; STATES];
-        s.copy_from_slice(x);
+        s.copy_from_slice(&x[..STATES]);
+        let mut bank = [0.0; CELL_STATES];
+        bank.copy_from_slice(&x[STATES..]);
         let sim = self
             .sim
             .as_mut()
             .ok_or_else(|| refuse("fmi2SetContinuousStates: no simulation (not initialised)"))?;
-        sim.set_continuous_states(&s).map_err(|why| {
-            refuse(format!(
-                "fmi2SetContinuousStates: {why}; the states are left as they were"
-            ))
+        sim.set_all_continuous_states(&s, &bank).map_err(|why| {
+            let (status, why) = match why {
+                // The host may retry with a shorter step.
+                CellRefusal::Step(why) => (Status::Discard, why),
+                CellRefusal::Invalid(why) => (Status::Error, why),
+            };
+            Refusal::new(
+                status,
+                format!("fmi2SetContinuousStates: {why}; the states are left as they were"),
+            )
         })?;
         Ok(Status::Ok)
     }
 
     fn derivatives(&self, context: &Context, dx: &mut [f64]) -> Reply {
         let inputs = self.values.inputs([0.0; 2]);
-        let d = self
-            .running("fmi2GetDerivatives")?
-            .continuous_derivatives(&inputs);
+        let sim = self.running("fmi2GetDerivatives")?;
+        let mut d = [0.0; ALL_STATES];
+        let (core, cells) = split(&mut d);
+        core.copy_from_slice(&sim.continuous_derivatives(&inputs));
+        sim.cell_derivatives(&inputs, cells);
         copy_finite(
             "fmi2GetDerivatives",
             "derivative",
@@ -164,11 +215,10 @@ impl Continuous for Tld {
     }
 
     fn nominals(&self, out: &mut [f64]) -> Reply {
-        out.copy_from_slice(
-            &self
-                .running("fmi2GetNominalsOfContinuousStates")?
-                .continuous_nominals(),
-        );
+        let sim = self.running("fmi2GetNominalsOfContinuousStates")?;
+        let (core, cells) = split(out);
+        core.copy_from_slice(&sim.continuous_nominals());
+        sim.cell_nominals(cells);
         Ok(Status::Ok)
     }
 
@@ -193,4 +243,12 @@ impl Continuous for Tld {
             .map_err(|why| refuse(format!("{F}: {why}")))?;
         copy_finite(F, "entry", context, inputs.a, &out, dv_unknown)
     }
+}
+
+/// The host's array of all states (the layer checked its length) as the four and the bank.
+fn split(x: &mut [f64]) -> (&mut [f64], &mut [f64; CELL_STATES]) {
+    let (core, cells) = x.split_at_mut(STATES);
+    let cells = <&mut [f64; CELL_STATES]>::try_from(cells)
+        .unwrap_or_else(|_| unreachable!("the layer checks the length"));
+    (core, cells)
 }

@@ -5,11 +5,14 @@
 //! derivatives are the exact output rates every model already provides ([`Model::rate`]), so
 //! no equation is written twice. Knows no FMI.
 //!
+//! ShallowWater is offered with swe.cells up to the bank of cells the model description
+//! declares (`shallow_water::continuous`): its cells are states of their own, and the four
+//! above are functions of them (energy.input excepted, the work's integral).
+//!
 //! Not offered, each with its reason: SloshingSlamming (its impacts are instants that change
-//! the velocity: state events with an event iteration, not yet written) and ShallowWater (its
-//! 2 x swe.cells states cannot be declared in an FMI 2.0 model description whose number of
-//! states is fixed, while swe.cells is a parameter). A Linear model of more than one mode
-//! would need more states than the model description declares.
+//! the velocity: state events with an event iteration, not yet written), ShallowWater with
+//! more cells than the bank. A Linear model of more than one mode would need more states than
+//! the model description declares.
 //!
 //! Directional derivatives (J d, for a host's implicit solver): the exact derivatives of the
 //! same rates in the states and the base acceleration, the damping ratio fixed (amplitude =
@@ -108,12 +111,7 @@ impl AnyModel {
                  events (the gap to each wall as event indicator) that are not yet offered"
                     .into(),
             ),
-            AnyModel::ShallowWater(_) => Err(
-                "model = ShallowWater is Co-Simulation only: its 2 x swe.cells states cannot be \
-                 declared in an FMI 2.0 model description, where the number of states is fixed \
-                 and swe.cells is a parameter"
-                    .into(),
-            ),
+            AnyModel::ShallowWater(m) => m.fits_model_exchange(),
         }
     }
 
@@ -205,7 +203,8 @@ mod tests {
         let why = |m: AnyModel| m.offers_model_exchange().err().unwrap_or_default();
         assert!(why(model(ModelKindItem::Linear, 3.0)).contains("modes = 1"));
         assert!(why(model(ModelKindItem::SloshingSlamming, 1.0)).contains("state events"));
-        assert!(why(model(ModelKindItem::ShallowWater, 1.0)).contains("swe.cells"));
+        assert!(why(shallow_water(201.0)).contains("swe.cells = 201"));
+        assert!(shallow_water(200.0).offers_model_exchange().is_ok());
     }
 
     /// Nor have they a Jacobian: refused with the same reason, never numbers.
@@ -214,11 +213,26 @@ mod tests {
         for (item, modes) in [
             (ModelKindItem::Linear, 3.0),
             (ModelKindItem::SloshingSlamming, 1.0),
-            (ModelKindItem::ShallowWater, 1.0),
         ] {
             let m = model(item, modes);
             let got = m.continuous_tangent(0.1, &Direction::default());
             assert_eq!(got.err(), m.offers_model_exchange().err(), "{item:?}");
         }
+        let m = shallow_water(201.0);
+        let got = m.continuous_tangent(0.1, &Direction::default());
+        assert_eq!(got.err(), m.offers_model_exchange().err());
+        // Offered, but without directional derivatives (the limiter's kinks): said so.
+        let got = shallow_water(150.0).continuous_tangent(0.1, &Direction::default());
+        assert!(got.is_err_and(|why| why.contains("no directional derivatives")));
+    }
+
+    fn shallow_water(cells: f64) -> AnyModel {
+        let p = StartValues::default().with(vr::SWE_CELLS, cells);
+        let (common, _) = Common::read(&p).expect("start values are consistent");
+        let start = Start {
+            zeta: 0.02,
+            amplitude: 0.005,
+        };
+        AnyModel::configure(ModelKindItem::ShallowWater, &p, &common, start).expect("configures")
     }
 }

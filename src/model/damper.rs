@@ -356,6 +356,7 @@ fn per_step(model: &AnyModel) -> [f64; 3] {
     [model.force(), x, v]
 }
 
+mod cells;
 mod continuous;
 pub use continuous::Unknown;
 

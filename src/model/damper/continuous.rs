@@ -13,6 +13,8 @@ use crate::model::{AmplitudeSource, Inputs, Output};
 pub enum Unknown {
     Derivative(usize),
     Output(Output),
+    /// The derivative of a state this model does not have (identically 0).
+    Frozen,
 }
 
 impl Damper {
@@ -85,6 +87,7 @@ impl Damper {
                     format!("there are {STATES} state derivatives, not {}", k + 1)
                 })?,
                 Unknown::Output(which) => self.output_tangent(which, d, t.force, t.stored)?,
+                Unknown::Frozen => 0.0,
             });
         }
         out.copy_from_slice(&values);
