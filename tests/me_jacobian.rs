@@ -13,7 +13,7 @@ use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType, vr};
 
 const N: usize = 4;
 /// All continuous states: the four, then the ShallowWater cell bank (0 for these models).
-const ALL: usize = N + tld_fmu::model::shallow_water::continuous::CELL_STATES;
+const ALL: usize = tld_fmu::model::continuous::ALL_STATES;
 const LINEAR: i32 = 1;
 const NONLINEAR: i32 = 2;
 const AUTO: i32 = 4;

@@ -10,8 +10,7 @@ use tld_fmu::fmi::vars::vr;
 
 /// Continuous states of TLD.fmu in ME: slosh.x, slosh.v, energy.input, energy.dissipated, then
 /// the ShallowWater cell bank (all 0 for the other models).
-const N: usize =
-    tld_fmu::model::continuous::STATES + tld_fmu::model::shallow_water::continuous::CELL_STATES;
+const N: usize = tld_fmu::model::continuous::ALL_STATES;
 
 /// The four states `core` and the cell bank at 0.
 fn padded(core: [f64; 4]) -> Vec<f64> {
@@ -178,10 +177,30 @@ fn a_model_not_offered_says_why_and_another_can_be_chosen() {
     assert_eq!(inst.derivatives(N).0, ERROR);
     assert_eq!(inst.set_integer(vr::MODEL, NONLINEAR), OK);
     assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
+    // amplitude = Tracked is offered (its estimator's states follow the host's solution), but
+    // has no directional derivatives: said so.
     let tracked = in_initialisation("me-tracked", NONLINEAR, 0.0);
     assert_eq!(tracked.set_integer(vr::AMPLITUDE, 2), OK);
-    assert_eq!(tracked.exit(), ERROR);
-    assert!(tracked.logs().join("\n").contains("amplitude = Tracked"));
+    assert_eq!(tracked.exit(), OK, "{:?}", tracked.logs());
+    let mut out = [0.0];
+    let status = unsafe {
+        tracked.lib.fmi2GetDirectionalDerivative(
+            tracked.c,
+            [vr::DER_SLOSH_V_].as_ptr(),
+            1,
+            [vr::SLOSH_X].as_ptr(),
+            1,
+            [1.0].as_ptr(),
+            out.as_mut_ptr(),
+        )
+    };
+    assert_eq!(status, ERROR);
+    assert!(
+        tracked
+            .logs()
+            .join("\n")
+            .contains("amplitude = Tracked has no directional")
+    );
 }
 
 /// An FMU state saved in continuous-time mode restores (in this and in a new ME instance, from
@@ -260,7 +279,8 @@ fn instantiating_for_model_exchange_says_what_is_offered() {
     for part in [
         "Linear (modes = 1)",
         "ShallowWater (swe.cells <= 200)",
-        "SloshingSlamming and amplitude = Tracked",
+        "amplitude = Fixed or Tracked",
+        "SloshingSlamming is Co-Simulation only",
     ] {
         assert!(said.contains(part), "no '{part}' in: {said}");
     }

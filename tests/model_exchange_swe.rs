@@ -14,9 +14,10 @@ use tld_fmu::model::shallow_water::continuous::{CELL_STATES, ME_CELLS};
 
 const N: usize = tld_fmu::model::continuous::STATES + CELL_STATES;
 const SHALLOW_WATER: i32 = 5;
-/// The bank's first depth and discharge in the state vector.
-const H0: usize = 4;
-const Q0: usize = 4 + ME_CELLS;
+/// The bank's first depth and discharge in the state vector (after the four and the
+/// amplitude estimator's seven).
+const H0: usize = N - CELL_STATES;
+const Q0: usize = H0 + ME_CELLS;
 
 struct Case {
     cells: f64,

@@ -6,17 +6,15 @@
 
 use fmi2_slave::{Context, Continuous, Refusal, Reply, Status, refuse};
 
-use super::me_cells::{Cell, cell_of};
+use super::me_cells::{Cell, cell_of, tracker_of};
 
 use super::params::output_of;
 use super::slave::Tld;
 use super::vars::{VARIABLES, VarType, index_of, vr};
-use crate::model::continuous::{Direction, STATES};
-use crate::model::shallow_water::continuous::{CELL_STATES, CellRefusal};
+use crate::model::continuous::{ALL_STATES, Direction, STATES};
+use crate::model::shallow_water::continuous::{CELL_STATES, StatesRefused};
 use crate::model::{Damper, Unknown};
-
-/// All continuous states: the four of every offered model, then the ShallowWater cell bank.
-const ALL_STATES: usize = STATES + CELL_STATES;
+use crate::physics::amplitude::TRACKER_CONTINUOUS;
 
 /// The state derivative variables, in state order.
 const DERIVATIVES: [u32; STATES] = [
@@ -47,6 +45,9 @@ fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
                 // A cell: no equation of a model without cells reads it (and a model with cells
                 // has no directional derivatives).
                 None if matches!(cell_of(r), Some(Cell::State(_))) => continue,
+                // The estimator's: read by no equation with a fixed amplitude (and a tracked
+                // one has no directional derivatives).
+                None if matches!(tracker_of(r), Some((_, false))) => continue,
                 None => {
                     return Err(refuse(format!(
                         "fmi2GetDirectionalDerivative: value reference {r} is neither a \
@@ -66,7 +67,7 @@ fn unknown(r: u32) -> Result<Unknown, Refusal> {
     if let Some(k) = DERIVATIVES.iter().position(|&d| d == r) {
         return Ok(Unknown::Derivative(k));
     }
-    if let Some(Cell::Derivative(_)) = cell_of(r) {
+    if let (Some(Cell::Derivative(_)), _) | (_, Some((_, true))) = (cell_of(r), tracker_of(r)) {
         return Ok(Unknown::Frozen);
     }
     let real = index_of(r).is_some_and(|k| VARIABLES[k].ty == VarType::Real);
@@ -115,6 +116,9 @@ impl Tld {
         r: u32,
     ) -> Option<Result<f64, Refusal>> {
         let Some(k) = DERIVATIVES.iter().position(|&d| d == r) else {
+            if let Some((k, derivative)) = tracker_of(r) {
+                return Some(self.tracker_value(context, k, derivative));
+            }
             return self.cell_value(context, cell_of(r)?);
         };
         // Before initialisation (hosts read the initial unknowns in initialisation mode): from
@@ -129,6 +133,20 @@ impl Tld {
 }
 
 impl Tld {
+    /// The estimator's state or derivative `k` (0 with a fixed amplitude).
+    fn tracker_value(&self, context: &Context, k: usize, derivative: bool) -> Result<f64, Refusal> {
+        let mut provisional = None;
+        let inputs = self.values.inputs([0.0; 2]);
+        let mut out = [0.0; TRACKER_CONTINUOUS];
+        let sim = self.simulation(context, &mut provisional)?;
+        if derivative {
+            sim.tracker_derivatives(&inputs, &mut out);
+        } else {
+            sim.tracker_states(&mut out);
+        }
+        Ok(out[k])
+    }
+
     /// A cell's state or derivative (0 for a model without cells).
     fn cell_value(&self, context: &Context, cell: Cell) -> Option<Result<f64, Refusal>> {
         let mut provisional = None;
@@ -154,10 +172,11 @@ impl Continuous for Tld {
     const STATES: usize = ALL_STATES;
     const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
         "Model Exchange offers model = Linear (modes = 1), Nonlinear, Auto and ShallowWater \
-         (swe.cells <= 200) with amplitude = Fixed; the states are slosh.x, slosh.v, \
-         energy.input, energy.dissipated, then the ShallowWater cells swe.h[i], swe.q[i] (frozen \
-         at 0 for the other models). SloshingSlamming and amplitude = Tracked are Co-Simulation \
-         only (fmi2ExitInitializationMode says why); see docs/MODEL_EXCHANGE.md",
+         (swe.cells <= 200) with amplitude = Fixed or Tracked; the states are slosh.x, \
+         slosh.v, energy.input, energy.dissipated, the amplitude estimator's A_e.tracker.*, \
+         then the ShallowWater cells swe.h[i], swe.q[i] (frozen at 0 where the model has none). \
+         SloshingSlamming is Co-Simulation only (fmi2ExitInitializationMode says why); see \
+         docs/MODEL_EXCHANGE.md",
     );
 
     fn offers_model_exchange(&self) -> Result<(), String> {
@@ -168,32 +187,35 @@ impl Continuous for Tld {
 
     fn states(&self, x: &mut [f64]) -> Reply {
         let sim = self.running("fmi2GetContinuousStates")?;
-        let (core, cells) = split(x);
+        let (core, tracker, cells) = split(x);
         core.copy_from_slice(&sim.continuous_states());
+        sim.tracker_states(tracker);
         sim.cell_states(cells);
         Ok(Status::Ok)
     }
 
     fn set_states(&mut self, _: &Context, x: &[f64]) -> Reply {
-        let mut s = [0.0; STATES];
-        s.copy_from_slice(&x[..STATES]);
-        let mut bank = [0.0; CELL_STATES];
-        bank.copy_from_slice(&x[STATES..]);
+        let mut all = [0.0; ALL_STATES];
+        all.copy_from_slice(x);
+        let (s, tracker, bank) = split(&mut all);
+        let s = <&[f64; STATES]>::try_from(&*s)
+            .unwrap_or_else(|_| unreachable!("STATES long by construction"));
         let sim = self
             .sim
             .as_mut()
             .ok_or_else(|| refuse("fmi2SetContinuousStates: no simulation (not initialised)"))?;
-        sim.set_all_continuous_states(&s, &bank).map_err(|why| {
-            let (status, why) = match why {
-                // The host may retry with a shorter step.
-                CellRefusal::Step(why) => (Status::Discard, why),
-                CellRefusal::Invalid(why) => (Status::Error, why),
-            };
-            Refusal::new(
-                status,
-                format!("fmi2SetContinuousStates: {why}; the states are left as they were"),
-            )
-        })?;
+        sim.set_all_continuous_states(s, tracker, bank)
+            .map_err(|why| {
+                let (status, why) = match why {
+                    // The host may retry with a shorter step.
+                    StatesRefused::Step(why) => (Status::Discard, why),
+                    StatesRefused::Invalid(why) => (Status::Error, why),
+                };
+                Refusal::new(
+                    status,
+                    format!("fmi2SetContinuousStates: {why}; the states are left as they were"),
+                )
+            })?;
         Ok(Status::Ok)
     }
 
@@ -201,8 +223,9 @@ impl Continuous for Tld {
         let inputs = self.values.inputs([0.0; 2]);
         let sim = self.running("fmi2GetDerivatives")?;
         let mut d = [0.0; ALL_STATES];
-        let (core, cells) = split(&mut d);
+        let (core, tracker, cells) = split(&mut d);
         core.copy_from_slice(&sim.continuous_derivatives(&inputs));
+        sim.tracker_derivatives(&inputs, tracker);
         sim.cell_derivatives(&inputs, cells);
         copy_finite(
             "fmi2GetDerivatives",
@@ -216,10 +239,31 @@ impl Continuous for Tld {
 
     fn nominals(&self, out: &mut [f64]) -> Reply {
         let sim = self.running("fmi2GetNominalsOfContinuousStates")?;
-        let (core, cells) = split(out);
+        let (core, tracker, cells) = split(out);
         core.copy_from_slice(&sim.continuous_nominals());
+        sim.tracker_nominals(tracker);
         sim.cell_nominals(cells);
         Ok(Status::Ok)
+    }
+
+    /// amplitude = Tracked: a base.v other than 0 switches the estimator to it (an event).
+    fn completed_step(&mut self, _: &Context) -> Result<bool, Refusal> {
+        let inputs = self.values.inputs([0.0; 2]);
+        Ok(self
+            .running("fmi2CompletedIntegratorStep")?
+            .tracker_event_pending(&inputs))
+    }
+
+    fn event_update(&mut self, _: &Context) -> Result<fmi2_slave::EventUpdate, Refusal> {
+        let inputs = self.values.inputs([0.0; 2]);
+        let sim = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| refuse("fmi2NewDiscreteStates: no simulation (not initialised)"))?;
+        Ok(fmi2_slave::EventUpdate {
+            states_changed: sim.tracker_event(&inputs),
+            next_event: None,
+        })
     }
 
     fn directional_derivative(
@@ -245,10 +289,23 @@ impl Continuous for Tld {
     }
 }
 
-/// The host's array of all states (the layer checked its length) as the four and the bank.
-fn split(x: &mut [f64]) -> (&mut [f64], &mut [f64; CELL_STATES]) {
-    let (core, cells) = x.split_at_mut(STATES);
-    let cells = <&mut [f64; CELL_STATES]>::try_from(cells)
-        .unwrap_or_else(|_| unreachable!("the layer checks the length"));
-    (core, cells)
+/// The host's array of all states (the layer checked its length) as the four, the
+/// estimator's and the bank.
+#[allow(clippy::type_complexity)]
+fn split(
+    x: &mut [f64],
+) -> (
+    &mut [f64],
+    &mut [f64; TRACKER_CONTINUOUS],
+    &mut [f64; CELL_STATES],
+) {
+    let (core, rest) = x.split_at_mut(STATES);
+    let (tracker, cells) = rest.split_at_mut(TRACKER_CONTINUOUS);
+    (
+        core,
+        <&mut [f64; TRACKER_CONTINUOUS]>::try_from(tracker)
+            .unwrap_or_else(|_| unreachable!("TRACKER_CONTINUOUS long by construction")),
+        <&mut [f64; CELL_STATES]>::try_from(cells)
+            .unwrap_or_else(|_| unreachable!("the layer checks the length")),
+    )
 }

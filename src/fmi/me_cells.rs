@@ -1,9 +1,27 @@
-//! TLD.fmu in Model Exchange: the value references of the ShallowWater cell bank
-//! (scripts/me-cells-xml declares them): swe.h[i] = 1000 + i, swe.q[i] = 1500 + i and their
-//! derivatives der(swe.h[i]) = 2000 + i, der(swe.q[i]) = 2500 + i, i = 1 .. ME_CELLS. A
-//! position in the bank is cell i - 1 for a depth, ME_CELLS + i - 1 for a discharge.
+//! TLD.fmu in Model Exchange: the value references of the states beyond the first four.
+//! The amplitude estimator's (amplitude = Tracked): A_e.tracker.* = 200 + k and their
+//! derivatives 250 + k, k = 0 .. 6 in `AmplitudeTracker::continuous_state`'s order. The
+//! ShallowWater cell bank (scripts/me-cells-xml declares it): swe.h[i] = 1000 + i,
+//! swe.q[i] = 1500 + i and their derivatives der(swe.h[i]) = 2000 + i, der(swe.q[i]) =
+//! 2500 + i, i = 1 .. ME_CELLS. A position in the bank is cell i - 1 for a depth, ME_CELLS +
+//! i - 1 for a discharge.
 
 use crate::model::shallow_water::continuous::ME_CELLS;
+use crate::physics::amplitude::TRACKER_CONTINUOUS;
+
+const TRACKER: u32 = 200;
+const DER_TRACKER: u32 = 250;
+
+/// The estimator's state `r` names (its position), and whether as a derivative.
+pub fn tracker_of(r: u32) -> Option<(usize, bool)> {
+    let at = |base: u32| {
+        let k = r.checked_sub(base)? as usize;
+        (k < TRACKER_CONTINUOUS).then_some(k)
+    };
+    at(TRACKER)
+        .map(|k| (k, false))
+        .or_else(|| at(DER_TRACKER).map(|k| (k, true)))
+}
 
 const DEPTH: u32 = 1000;
 const DISCHARGE: u32 = 1500;
@@ -74,6 +92,26 @@ mod tests {
             cell_of(DER_DISCHARGE + 200),
             Some(Cell::Derivative(2 * ME_CELLS - 1))
         );
+        let names = [
+            "A_e.tracker.v",
+            "A_e.tracker.v2[1]",
+            "A_e.tracker.v2[2]",
+            "A_e.tracker.a2[1]",
+            "A_e.tracker.a2[2]",
+            "A_e.tracker.weight[1]",
+            "A_e.tracker.weight[2]",
+        ];
+        for (k, n) in names.iter().enumerate() {
+            assert_eq!(name(TRACKER + k as u32), Some(*n));
+            assert_eq!(
+                name(DER_TRACKER + k as u32),
+                Some(format!("der({n})").as_str())
+            );
+            assert_eq!(tracker_of(TRACKER + k as u32), Some((k, false)));
+            assert_eq!(tracker_of(DER_TRACKER + k as u32), Some((k, true)));
+        }
+        assert_eq!(tracker_of(TRACKER + 7), None);
+        assert_eq!(tracker_of(DER_TRACKER - 1), None);
         // The variables of the bank are the last in the model description.
         let last = VARIABLES
             .iter()

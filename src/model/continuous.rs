@@ -28,6 +28,12 @@ use super::{Observable, Output};
 /// Numbers of continuous states: x, v, energy.input, energy.dissipated.
 pub const STATES: usize = 4;
 
+/// All the continuous states the model description declares: those four, the amplitude
+/// estimator's (amplitude = Tracked) and the ShallowWater cell bank, in that order.
+pub const ALL_STATES: usize = STATES
+    + crate::physics::amplitude::TRACKER_CONTINUOUS
+    + super::shallow_water::continuous::CELL_STATES;
+
 /// The outputs whose rates are the states' derivatives, in state order.
 pub const RATES: [Output; STATES] = [
     Output::X,

@@ -20,7 +20,21 @@ impl MeanSquare {
         self.first += alpha * (sample - self.first);
         self.second += alpha * (self.first - self.second);
     }
+
+    /// The filters' time derivatives under `sample`, time constant `tau`: the ODEs whose exact
+    /// solution for a held sample [`MeanSquare::update`] is.
+    fn rates(&self, tau: f64, sample: f64) -> [f64; 2] {
+        [
+            (sample - self.first) / tau,
+            (self.first - self.second) / tau,
+        ]
+    }
 }
+
+/// Number of values in [`AmplitudeTracker::continuous_state`]: the rebuilt velocity and the
+/// three filter pairs, the estimator as ODEs in continuous time (the velocity source, measured
+/// or rebuilt, is a discrete state).
+pub const TRACKER_CONTINUOUS: usize = 7;
 
 /// Number of values in [`AmplitudeTracker::state`].
 pub const TRACKER_STATE: usize = 8;
@@ -115,23 +129,75 @@ impl AmplitudeTracker {
             decay_m1,
             ..
         } = self.coefficients;
-        if velocity != 0.0 && !self.measured_v_seen {
-            // The host drives base.v: restart the velocity statistics from the measured signal.
-            self.measured_v_seen = true;
-            self.ms_v = MeanSquare::default();
-            self.ms_a = MeanSquare::default();
-            self.weight = MeanSquare::default();
-        }
-        let v = if self.measured_v_seen {
-            velocity
-        } else {
-            self.rebuilt_v
-        };
+        self.sees_velocity(velocity);
+        let v = self.velocity(velocity);
         self.ms_v.update(alpha, v * v);
         self.ms_a.update(alpha, accel * accel);
         self.weight.update(alpha, 1.0);
         // Exact advance of v' = a - w_c v with a held.
         self.rebuilt_v = self.rebuilt_v * decay - accel * decay_m1 / self.leak;
+    }
+
+    /// Whether the host's base velocity `velocity` switches the estimator to it (it is not 0
+    /// and the estimator still rebuilds the velocity from the acceleration).
+    pub fn would_see_velocity(&self, velocity: f64) -> bool {
+        velocity != 0.0 && !self.measured_v_seen
+    }
+
+    /// The host drives base.v: restart the velocity statistics from the measured signal (once).
+    /// True if it did.
+    pub fn sees_velocity(&mut self, velocity: f64) -> bool {
+        if !self.would_see_velocity(velocity) {
+            return false;
+        }
+        self.measured_v_seen = true;
+        self.ms_v = MeanSquare::default();
+        self.ms_a = MeanSquare::default();
+        self.weight = MeanSquare::default();
+        true
+    }
+
+    /// The velocity the statistics take: the host's, or the rebuilt one.
+    fn velocity(&self, velocity: f64) -> f64 {
+        if self.measured_v_seen {
+            velocity
+        } else {
+            self.rebuilt_v
+        }
+    }
+
+    /// The estimator's continuous part: [rebuilt v, <v^2> first, second, <a^2> first, second,
+    /// weight first, second].
+    pub fn continuous_state(&self) -> [f64; TRACKER_CONTINUOUS] {
+        [
+            self.rebuilt_v,
+            self.ms_v.first,
+            self.ms_v.second,
+            self.ms_a.first,
+            self.ms_a.second,
+            self.weight.first,
+            self.weight.second,
+        ]
+    }
+
+    /// Take the continuous part (as [`AmplitudeTracker::continuous_state`] gives it); the
+    /// velocity source stays. Err (nothing taken) for a negative mean square or weight, which
+    /// the ODEs never reach (a step far longer than tau does).
+    pub fn set_continuous_state(&mut self, s: &[f64; TRACKER_CONTINUOUS]) -> Result<(), String> {
+        let mut saved = self.state();
+        saved[0] = s[0];
+        saved[2..].copy_from_slice(&s[1..]);
+        self.set_state(&saved)
+    }
+
+    /// The time derivatives of [`AmplitudeTracker::continuous_state`] under the base
+    /// acceleration `accel` and velocity `velocity`: v' = a - w_c v and each filter pair's.
+    pub fn continuous_rates(&self, accel: f64, velocity: f64) -> [f64; TRACKER_CONTINUOUS] {
+        let v = self.velocity(velocity);
+        let [v1, v2] = self.ms_v.rates(self.tau, v * v);
+        let [a1, a2] = self.ms_a.rates(self.tau, accel * accel);
+        let [w1, w2] = self.weight.rates(self.tau, 1.0);
+        [accel - self.leak * self.rebuilt_v, v1, v2, a1, a2, w1, w2]
     }
 
     /// The evolving part of the estimator, for saving the state.

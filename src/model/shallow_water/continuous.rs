@@ -22,7 +22,7 @@ pub const CELL_STATES: usize = 2 * ME_CELLS;
 
 /// Why the bank's states were refused.
 #[derive(Clone, Debug, PartialEq)]
-pub enum CellRefusal {
+pub enum StatesRefused {
     /// A depth below 0: the host's step was too long (a shorter one may succeed).
     Step(String),
     /// Not this tank's liquid at all.
@@ -71,17 +71,17 @@ impl ShallowWater {
     }
 
     /// Take the bank's depths and discharges and the work done on the liquid `work` [J]; all
-    /// or nothing. A negative depth is [`CellRefusal::Step`]; liquid lost or gained (the
+    /// or nothing. A negative depth is [`StatesRefused::Step`]; liquid lost or gained (the
     /// semi-discrete equations conserve it exactly, the host's solver to round-off) is
-    /// [`CellRefusal::Invalid`].
+    /// [`StatesRefused::Invalid`].
     pub(in crate::model) fn set_cell_states(
         &mut self,
         cells: &[f64; CELL_STATES],
         work: f64,
-    ) -> Result<(), CellRefusal> {
+    ) -> Result<(), StatesRefused> {
         let n = self.channel.cells;
         if let Some(i) = cells[..n].iter().position(|&h| h < 0.0) {
-            return Err(CellRefusal::Step(format!(
+            return Err(StatesRefused::Step(format!(
                 "swe.h[{}] = {:e} m: the host's step drove a depth below 0 (a shorter step \
                  keeps it >= 0)",
                 i + 1,
@@ -93,7 +93,7 @@ impl ShallowWater {
         saved.extend_from_slice(&cells[ME_CELLS..ME_CELLS + n]);
         saved.push(work);
         use super::Model;
-        self.load(&saved).map_err(CellRefusal::Invalid)
+        self.load(&saved).map_err(StatesRefused::Invalid)
     }
 }
 
@@ -138,7 +138,7 @@ impl crate::model::AnyModel {
         cells: &[f64; CELL_STATES],
         input: f64,
         initial_energy: f64,
-    ) -> Result<bool, CellRefusal> {
+    ) -> Result<bool, StatesRefused> {
         match self {
             crate::model::AnyModel::ShallowWater(m) => {
                 m.set_cell_states(cells, input - initial_energy)?;
