@@ -169,15 +169,9 @@ impl AmplitudeTracker {
     /// The estimator's continuous part: [rebuilt v, <v^2> first, second, <a^2> first, second,
     /// weight first, second].
     pub fn continuous_state(&self) -> [f64; TRACKER_CONTINUOUS] {
-        [
-            self.rebuilt_v,
-            self.ms_v.first,
-            self.ms_v.second,
-            self.ms_a.first,
-            self.ms_a.second,
-            self.weight.first,
-            self.weight.second,
-        ]
+        // The saved state without its flag (position 1).
+        let s = self.state();
+        std::array::from_fn(|k| s[if k == 0 { 0 } else { k + 1 }])
     }
 
     /// Take the continuous part (as [`AmplitudeTracker::continuous_state`] gives it); the
