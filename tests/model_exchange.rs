@@ -8,21 +8,16 @@ mod common;
 use common::*;
 use tld_fmu::fmi::vars::vr;
 
-/// Continuous states of TLD.fmu in ME: slosh.x, slosh.v, energy.input, energy.dissipated, then
-/// the ShallowWater cell bank (all 0 for the other models).
+/// Continuous states of TLD.fmu in ME: slosh.x, slosh.v, energy.input, energy.dissipated,
+/// impact.z, impact.v, the Linear model's mode[n].x, mode[n].v (n = 2..10), the amplitude
+/// estimator's 7 and the ShallowWater cell bank (frozen at 0 where unused).
 const N: usize = tld_fmu::model::continuous::ALL_STATES;
-
-/// The four states `core` and the cell bank at 0.
-fn padded(core: [f64; 4]) -> Vec<f64> {
-    let mut x = vec![0.0; N];
-    x[..4].copy_from_slice(&core);
-    x
-}
 /// Items: model = Linear (1), Nonlinear (2), SloshingSlamming (3); damping Constant (1);
 /// amplitude Fixed (1).
 const LINEAR: i32 = 1;
 const NONLINEAR: i32 = 2;
 const SLAMMING: i32 = 3;
+const SHALLOW_WATER: i32 = 5;
 
 /// An ME instance with `model`, constant damping 0.02, amplitude Fixed, slosh.x0 = x0, in
 /// initialisation mode.
@@ -68,8 +63,9 @@ fn a_host_integrates_the_free_decay_to_its_closed_form() {
         nominal.iter().all(|v| *v > 0.0 && v.is_finite()),
         "{nominal:?}"
     );
-    let (s, none) = inst.event_indicators(0);
-    assert_eq!((s, none.len()), (OK, 0));
+    // Two event indicators (S^2's walls); a model without events: never crossing.
+    let (s, z) = inst.event_indicators(2);
+    assert_eq!((s, z), (OK, vec![1.0, 1.0]));
     let w = inst.real(vr::OMEGA_F);
     let zeta: f64 = 0.02;
     let t1: f64 = 4.0;
@@ -132,8 +128,12 @@ fn calls_out_of_order_say_what_to_call_first() {
     assert_eq!(me.new_discrete_states().0, ERROR);
     // Wrong array lengths, and a non-finite state.
     assert_eq!(me.derivatives(N + 1).0, ERROR);
-    assert_eq!(me.set_states(&padded([0.0, f64::NAN, 0.0, 0.0])), ERROR);
-    assert_eq!(me.set_states(&padded([1e6, 0.0, 0.0, 0.0])), ERROR);
+    let mut bad = [0.0; N];
+    bad[1] = f64::NAN;
+    assert_eq!(me.set_states(&bad), ERROR);
+    let mut far = [0.0; N];
+    far[0] = 1e6;
+    assert_eq!(me.set_states(&far), ERROR);
     let (_, x) = me.states(N);
     assert_eq!(
         x, [0.0; N],
@@ -146,7 +146,7 @@ fn calls_out_of_order_say_what_to_call_first() {
         "fmi2DoStep is not allowed in state EventMode",
         "fmi2CoSimulation",
         "Call fmi2EnterEventMode first",
-        "the model description declares 4",
+        "the model description declares 431",
         "state 1 is NaN",
         "ran away",
     ] {
@@ -167,10 +167,12 @@ fn calls_out_of_order_say_what_to_call_first() {
 /// instance stays in initialisation mode, where another model can be chosen.
 #[test]
 fn a_model_not_offered_says_why_and_another_can_be_chosen() {
-    let inst = in_initialisation("me-slamming", SLAMMING, 0.0);
+    let inst = in_initialisation("me-shallow", SHALLOW_WATER, 0.0);
+    // More cells than the bank the model description declares.
+    assert_eq!(inst.set_integer(vr::SWE_CELLS, 201), OK);
     assert_eq!(inst.exit(), ERROR);
     assert!(
-        inst.logs().join("\n").contains("state events"),
+        inst.logs().join("\n").contains("swe.cells = 201"),
         "{:?}",
         inst.logs()
     );
@@ -243,6 +245,7 @@ fn model_exchange_instances_in_threads_match_serial_runs() {
         (NONLINEAR, 0.02),
         (NONLINEAR, -0.015),
         (4, 0.03),
+        (SLAMMING, 0.02),
     ];
     assert_threads_match_serial(&cases, |name, (model, x0)| {
         let inst = running(&name, model, x0);
@@ -277,10 +280,10 @@ fn instantiating_for_model_exchange_says_what_is_offered() {
     unsafe { lib.fmi2FreeInstance(c) };
     let said = logs_of("me-note").join("\n");
     for part in [
-        "Linear (modes = 1)",
+        "Linear (modes <= 10)",
+        "SloshingSlamming (impacts as state events)",
         "ShallowWater (swe.cells <= 200)",
         "amplitude = Fixed or Tracked",
-        "SloshingSlamming is Co-Simulation only",
     ] {
         assert!(said.contains(part), "no '{part}' in: {said}");
     }

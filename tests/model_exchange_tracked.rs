@@ -11,8 +11,8 @@ use common::*;
 use tld_fmu::fmi::vars::vr;
 
 const N: usize = tld_fmu::model::continuous::ALL_STATES;
-/// The estimator's states follow the four.
-const T0: usize = 4;
+/// The estimator's states follow the 24 of the oscillators, the impact mass and the modes.
+const T0: usize = tld_fmu::model::continuous::STATES;
 const NONLINEAR: i32 = 2;
 const NSD: i32 = 2;
 /// Base motion A sin(w t) near the default tank's resonance (5.64 rad/s).

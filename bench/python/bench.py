@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import sys
 import tempfile
@@ -53,7 +54,8 @@ def main():
                     "throughput alone and replace its section of the existing report (about 4 minutes); "
                     "study-report: rewrite that section from the last measurement (bench/study.json)")
     ap.add_argument("--swe-only", action="store_true", help="only the shallow-water section: "
-                    "print it and write it to target/bench/swe.md (BENCHMARKS.md untouched)")
+                    "print it, write it to target/bench/swe.md and (without --quick) put it in place of "
+                    "the report's")
     ap.add_argument("--latency-only", action="store_true", help="only the step-time tails "
                     "section: print it, write it to target/bench/latency.md and (without --quick) "
                     "put it in place of the report's")
@@ -85,12 +87,15 @@ def main():
         (WORK / f"{name}.md").write_text(section)
         print(section)
         shutil.rmtree(fi.unzip, ignore_errors=True)
-        if name == "latency" and not args.quick:
-            # measured anew: in place of the report's section, saying when and on what
+        if not args.quick:
+            # measured anew: in place of the report's section, saying when, on what and
+            # under what load (the machine is shared)
+            load = " ".join(f"{x:.2f}" for x in os.getloadavg())
             lines[2:2] = [f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} by "
-                          f"`scripts/bench --latency-only` on {git_info()}.", ""]
+                          f"`scripts/bench --{name}-only` on {git_info()} (load average after "
+                          f"the runs: {load}, 2 cores).", ""]
             replace_section(out / "BENCHMARKS.md", lines)
-            print(f"wrote {out / 'BENCHMARKS.md'} (its step-time tails section)")
+            print(f"wrote {out / 'BENCHMARKS.md'} (its {lines[0][3:]} section)")
         return
 
     scenes = make_scenes(args.quick)

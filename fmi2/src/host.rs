@@ -18,7 +18,7 @@ fn bad_pointer(call: &Call, what: &str, n: usize) -> Refusal {
 
 /// Whether `ptr` can be a host array of `n` > 0 elements.
 #[inline(always)]
-fn valid_array<T>(ptr: *const T, n: usize) -> bool {
+pub(crate) fn valid_array<T>(ptr: *const T, n: usize) -> bool {
     !ptr.is_null() && ptr.is_aligned() && n <= isize::MAX as usize / size_of::<T>().max(1)
 }
 

@@ -77,6 +77,26 @@ pub trait Slave: Continuous {
         from: fn(T) -> f64,
     ) -> Reply;
 
+    /// The quick path of fmi2Set{Real,Integer,Boolean} for one value (the per-step input): set
+    /// `r` to `value` read as `ty` and answer true if [`Slave::set`] would take it as it is, in
+    /// every phase that allows a set, with nothing to say; false leaves the slave as it was and
+    /// the call to [`Slave::set`] (which decides again and says why). The default takes none.
+    #[inline(always)]
+    fn set_quietly(&mut self, r: u32, value: f64, ty: VarType) -> bool {
+        let _ = (r, value, ty);
+        false
+    }
+
+    /// The quick path of fmi2Get{Real,Integer,Boolean}: the value of `r` read as `ty` if it is
+    /// what [`Slave::get`] answers, in every phase that allows a get, with nothing to say (a
+    /// stored value, an output kept with the state); None: ask [`Slave::get`]. The default
+    /// answers none.
+    #[inline(always)]
+    fn get_quietly(&self, r: u32, ty: VarType) -> Option<f64> {
+        let _ = (r, ty);
+        None
+    }
+
     /// fmi2SetRealInputDerivatives, for the next step only.
     fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Reply;
 

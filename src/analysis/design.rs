@@ -19,11 +19,12 @@
 
 use std::f64::consts::PI;
 
-use crate::analysis::excitation::{Optimum, RANDOM_SCREENS, TwoDof, warburton};
+use crate::analysis::excitation::{Optimum, TwoDof, warburton};
 use crate::description::{AmplitudeModeItem, DampingLawItem, ModelKindItem, vr};
 use crate::model::{Damper, Inputs, Output, StartValues};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{boundary_layer_zeta, nsd_kappa};
+use crate::physics::screens::RANDOM_SCREENS;
 use crate::physics::screens::{Arrangement, loss_coefficient};
 
 /// The structural mode and its excitation.

@@ -29,11 +29,6 @@
 use nalgebra::{DMatrix, DVector, Matrix4, Vector4};
 use std::f64::consts::PI;
 
-/// The random Screens law's factor (MODEL.md 11): zeta_s = K X for a sinusoid of amplitude X
-/// becomes zeta_s = 3 sqrt(pi/8) K sigma = 1.880 K sigma for Gaussian narrow-band response of
-/// standard deviation sigma (E|u|^3 / E[u^2] = 2 sqrt(2/pi) sigma against (8/(3 pi)) U).
-pub const RANDOM_SCREENS: f64 = 1.879_971_205_973_250_3;
-
 /// Which optimum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Optimum {
@@ -262,6 +257,7 @@ mod tests {
     /// cos^2, Simpson over a period), and its closed form 3 sqrt(pi/8).
     #[test]
     fn random_screens_factor_by_quadrature() {
+        use crate::physics::screens::RANDOM_SCREENS;
         let simpson = |f: &dyn Fn(f64) -> f64, a: f64, b: f64| {
             let n = 20000;
             let h = (b - a) / n as f64;

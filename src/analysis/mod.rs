@@ -10,6 +10,7 @@ pub mod excitation;
 pub mod harmonic;
 pub mod linearisation;
 pub mod random;
+pub mod stationary;
 pub mod sweep;
 
 /// ln Gamma(x) for x > 0 (Lanczos, g = 7, 9 terms: about 1e-15 relative).

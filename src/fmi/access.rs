@@ -70,7 +70,7 @@ impl Tld {
     /// The position of `r` if it is a Real input without bounds (the per-step input) and
     /// `value` finite: what the full check would accept, by one table look-up.
     #[inline(always)]
-    fn free_input(r: u32, value: f64, ty: VarType) -> Option<usize> {
+    pub(super) fn free_input(r: u32, value: f64, ty: VarType) -> Option<usize> {
         match (ty, free_real_input(r)) {
             (VarType::Real, Some(index)) if finite(value) => Some(index),
             _ => None,

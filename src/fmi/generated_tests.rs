@@ -3,8 +3,8 @@
 //! limit lost) fails these tests instead of reaching the FMU.
 
 use super::vars::{
-    AmplitudeModeItem, DampingLawItem, LOG_CATEGORIES, ModelKindItem, SolverMethodItem, VARIABLES,
-    VarType, limits, log_category, vr,
+    AmplitudeModeItem, DampingLawItem, LOG_CATEGORIES, ModelKindItem, ScreensResponseItem,
+    SolverMethodItem, VARIABLES, VarType, limits, log_category, vr,
 };
 
 const XML: &str = include_str!("../../modelDescription/modelDescription.xml");
@@ -114,6 +114,7 @@ fn all_generated() -> Vec<Generated> {
         generated!(DampingLawItem),
         generated!(AmplitudeModeItem),
         generated!(SolverMethodItem),
+        generated!(ScreensResponseItem),
     ]
 }
 
@@ -211,12 +212,24 @@ fn enumeration_variables_carry_the_items_of_their_type() {
                 .to_vec()
         )
     );
+    assert_eq!(
+        items(vr::SCREENS_RESPONSE),
+        expect(
+            ScreensResponseItem::ALL
+                .map(|i| (i.name(), i.value()))
+                .to_vec()
+        )
+    );
     // The Integer aliases accept 0 ("use the enumeration") and every item.
     for (max, n) in [
         (limits::MODEL_ID_MAX, ModelKindItem::ALL.len()),
         (limits::DAMPING_ID_MAX, DampingLawItem::ALL.len()),
         (limits::AMPLITUDE_ID_MAX, AmplitudeModeItem::ALL.len()),
         (limits::SOLVER_ID_MAX, SolverMethodItem::ALL.len()),
+        (
+            limits::SCREENS_RESPONSE_ID_MAX,
+            ScreensResponseItem::ALL.len(),
+        ),
     ] {
         assert_eq!(max as usize, n);
     }

@@ -4,33 +4,63 @@
 //! states) and that the states are finite. Value references become the model's states, inputs,
 //! derivatives and outputs here; the model computes J d.
 
-use fmi2_slave::{Context, Continuous, Refusal, Reply, Status, refuse};
+use fmi2_slave::{Context, Continuous, EventUpdate, Refusal, Reply, Status, refuse};
 
 use super::me_cells::{Cell, cell_of, tracker_of};
 
 use super::params::output_of;
 use super::slave::Tld;
 use super::vars::{VARIABLES, VarType, index_of, vr};
-use crate::model::continuous::{ALL_STATES, Direction, STATES};
+use crate::model::continuous::{ALL_STATES, BANK, Direction, STATES};
+use crate::model::events::EVENT_INDICATORS;
 use crate::model::shallow_water::continuous::{CELL_STATES, StatesRefused};
+use crate::model::slamming::Event;
 use crate::model::{Damper, Unknown};
 use crate::physics::amplitude::TRACKER_CONTINUOUS;
 
 /// The state derivative variables, in state order.
-const DERIVATIVES: [u32; STATES] = [
-    vr::DER_SLOSH_X_,
-    vr::DER_SLOSH_V_,
-    vr::DER_ENERGY_INPUT_,
-    vr::DER_ENERGY_DISSIPATED_,
-];
+const DERIVATIVES: [u32; STATES] = with_bank(
+    [
+        vr::DER_SLOSH_X_,
+        vr::DER_SLOSH_V_,
+        vr::DER_ENERGY_INPUT_,
+        vr::DER_ENERGY_DISSIPATED_,
+        vr::DER_IMPACT_Z_,
+        vr::DER_IMPACT_V_,
+    ],
+    2,
+);
 
 /// The continuous state variables, in state order.
-const STATE_VARIABLES: [u32; STATES] = [
-    vr::SLOSH_X,
-    vr::SLOSH_V,
-    vr::ENERGY_INPUT,
-    vr::ENERGY_DISSIPATED,
-];
+const STATE_VARIABLES: [u32; STATES] = with_bank(
+    [
+        vr::SLOSH_X,
+        vr::SLOSH_V,
+        vr::ENERGY_INPUT,
+        vr::ENERGY_DISSIPATED,
+        vr::IMPACT_Z,
+        vr::IMPACT_V,
+    ],
+    0,
+);
+
+/// `first`, then the Linear model's bank mode[n].x, mode[n].v (n = 2, 3, ...), whose value
+/// references run four a mode from mode[2].x's (x, v, der(x), der(v)): `offset` 2 gives the
+/// derivatives. The tests check every name.
+const fn with_bank(first: [u32; BANK], offset: u32) -> [u32; STATES] {
+    let mut out = [0; STATES];
+    let mut k = 0;
+    while k < STATES {
+        out[k] = if k < BANK {
+            first[k]
+        } else {
+            let (mode, which) = ((k - BANK) / 2, (k - BANK) % 2);
+            vr::MODE_2__X + 4 * mode as u32 + which as u32 + offset
+        };
+        k += 1;
+    }
+    out
+}
 
 /// The direction the host gives as changes `dv` of the states and inputs `knowns`.
 fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
@@ -51,8 +81,9 @@ fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
                 None => {
                     return Err(refuse(format!(
                         "fmi2GetDirectionalDerivative: value reference {r} is neither a \
-                         continuous state (slosh.x, slosh.v, energy.input, energy.dissipated) nor \
-                         an input (base.a, base.v, base.x)"
+                         continuous state (slosh.x, slosh.v, energy.input, energy.dissipated, \
+                         impact.z, impact.v, mode[n].x, mode[n].v) nor an input (base.a, base.v, \
+                         base.x)"
                     )));
                 }
             },
@@ -108,18 +139,26 @@ impl Tld {
 }
 
 impl Tld {
-    /// The value of a state derivative variable (der(slosh.x), ...) or of a cell's state or
-    /// derivative, if `r` names one.
+    /// The value of a state derivative variable (der(slosh.x), ...), of a state that is no
+    /// output (impact.v), or of the amplitude estimator's or a cell's state or derivative, if
+    /// `r` names one.
     pub(super) fn derivative_value(
         &self,
         context: &Context,
         r: u32,
     ) -> Option<Result<f64, Refusal>> {
-        let Some(k) = DERIVATIVES.iter().position(|&d| d == r) else {
-            if let Some((k, derivative)) = tracker_of(r) {
-                return Some(self.tracker_value(context, k, derivative));
-            }
-            return self.cell_value(context, cell_of(r)?);
+        // Ok(k): the derivative of state k; Err(k): state k.
+        let which = match DERIVATIVES.iter().position(|&d| d == r) {
+            Some(k) => Ok(k),
+            None => match STATE_VARIABLES.iter().position(|&s| s == r) {
+                Some(k) => Err(k),
+                None => {
+                    if let Some((k, derivative)) = tracker_of(r) {
+                        return Some(self.tracker_value(context, k, derivative));
+                    }
+                    return self.cell_value(context, cell_of(r)?);
+                }
+            },
         };
         // Before initialisation (hosts read the initial unknowns in initialisation mode): from
         // the simulation the parameters set so far would start.
@@ -127,7 +166,10 @@ impl Tld {
         let inputs = self.values.inputs([0.0; 2]);
         Some(
             self.simulation(context, &mut provisional)
-                .map(|sim| sim.continuous_derivatives(&inputs)[k]),
+                .map(|sim| match which {
+                    Ok(k) => sim.continuous_derivatives(&inputs)[k],
+                    Err(k) => sim.continuous_states()[k],
+                }),
         )
     }
 }
@@ -170,12 +212,16 @@ impl Tld {
 
 impl Continuous for Tld {
     const STATES: usize = ALL_STATES;
+    const EVENT_INDICATORS: usize = EVENT_INDICATORS;
     const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
-        "Model Exchange offers model = Linear (modes = 1), Nonlinear, Auto and ShallowWater \
-         (swe.cells <= 200) with amplitude = Fixed or Tracked; the states are slosh.x, \
-         slosh.v, energy.input, energy.dissipated, the amplitude estimator's A_e.tracker.*, \
-         then the ShallowWater cells swe.h[i], swe.q[i] (frozen at 0 where the model has none). \
-         SloshingSlamming is Co-Simulation only (fmi2ExitInitializationMode says why); see \
+        "Model Exchange offers model = Linear (modes <= 10), Nonlinear, Auto, \
+         SloshingSlamming (impacts as state events) and ShallowWater (swe.cells <= 200) with \
+         amplitude = Fixed or Tracked; the states are slosh.x, slosh.v, energy.input, \
+         energy.dissipated, impact.z, impact.v, mode[n].x, mode[n].v (n = 2..10, Linear's \
+         higher modes), the amplitude estimator's A_e.tracker.*, then the ShallowWater cells \
+         swe.h[i], swe.q[i] (each frozen at 0 where the configuration has none). Linear with \
+         more modes and ShallowWater with more cells are Co-Simulation only \
+         (fmi2ExitInitializationMode says why); see \
          docs/MODEL_EXCHANGE.md",
     );
 
@@ -237,6 +283,36 @@ impl Continuous for Tld {
         )
     }
 
+    fn event_indicators(&self, context: &Context, out: &mut [f64]) -> Reply {
+        let inputs = self.values.inputs([0.0; 2]);
+        let z = self
+            .running("fmi2GetEventIndicators")?
+            .event_indicators(&inputs);
+        copy_finite(
+            "fmi2GetEventIndicators",
+            "event indicator",
+            context,
+            inputs.a,
+            &z,
+            out,
+        )
+    }
+
+    fn event_update(&mut self, _: &Context) -> Result<EventUpdate, Refusal> {
+        let inputs = self.values.inputs([0.0; 2]);
+        let sim = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| refuse("fmi2NewDiscreteStates: no simulation (not initialised)"))?;
+        let event = sim.event(&inputs);
+        // amplitude = Tracked: a base.v other than 0 switches the estimator (below).
+        let switched = sim.tracker_event(&inputs);
+        Ok(EventUpdate {
+            states_changed: matches!(event, Event::Impact { .. }) || switched,
+            next_event: None,
+        })
+    }
+
     fn nominals(&self, out: &mut [f64]) -> Reply {
         let sim = self.running("fmi2GetNominalsOfContinuousStates")?;
         let (core, tracker, cells) = split(out);
@@ -252,18 +328,6 @@ impl Continuous for Tld {
         Ok(self
             .running("fmi2CompletedIntegratorStep")?
             .tracker_event_pending(&inputs))
-    }
-
-    fn event_update(&mut self, _: &Context) -> Result<fmi2_slave::EventUpdate, Refusal> {
-        let inputs = self.values.inputs([0.0; 2]);
-        let sim = self
-            .sim
-            .as_mut()
-            .ok_or_else(|| refuse("fmi2NewDiscreteStates: no simulation (not initialised)"))?;
-        Ok(fmi2_slave::EventUpdate {
-            states_changed: sim.tracker_event(&inputs),
-            next_event: None,
-        })
     }
 
     fn directional_derivative(
@@ -308,4 +372,35 @@ fn split(
         <&mut [f64; CELL_STATES]>::try_from(cells)
             .unwrap_or_else(|_| unreachable!("the layer checks the length")),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn name(r: u32) -> &'static str {
+        index_of(r).map_or("?", |k| VARIABLES[k].name)
+    }
+
+    /// The bank's value references name mode[n].x, mode[n].v and their derivatives.
+    #[test]
+    fn the_bank_names_its_modes() {
+        for k in BANK..STATES {
+            let n = 2 + (k - BANK) / 2;
+            let which = if (k - BANK).is_multiple_of(2) {
+                "x"
+            } else {
+                "v"
+            };
+            let state = format!("mode[{n}].{which}");
+            assert_eq!(name(STATE_VARIABLES[k]), state);
+            assert_eq!(name(DERIVATIVES[k]), format!("der({state})"));
+        }
+        for k in 0..BANK {
+            assert_eq!(
+                name(DERIVATIVES[k]),
+                format!("der({})", name(STATE_VARIABLES[k]))
+            );
+        }
+    }
 }

@@ -96,11 +96,12 @@ impl Values {
 
 /// The Integer aliases that override enumerations (hosts that cannot set Enumeration variables,
 /// such as libcosim, use the alias); 0, their start value, leaves the enumeration in force.
-const ALIASES: [(u32, u32); 4] = [
+const ALIASES: [(u32, u32); 5] = [
     (vr::MODEL, vr::MODEL_ID),
     (vr::DAMPING, vr::DAMPING_ID),
     (vr::AMPLITUDE, vr::AMPLITUDE_ID),
     (vr::SOLVER, vr::SOLVER_ID),
+    (vr::SCREENS_RESPONSE, vr::SCREENS_RESPONSE_ID),
 ];
 
 /// The parameters as the models read them: the values the host set, each enumeration

@@ -167,6 +167,25 @@ impl Slave for Tld {
         Ok(fmi2_slave::Status::Ok)
     }
 
+    /// The per-step inputs (Real inputs without bounds) take any finite value: one table
+    /// look-up, as in [`Slave::set`].
+    #[inline(always)]
+    fn set_quietly(&mut self, r: u32, value: f64, ty: vars::VarType) -> bool {
+        match Self::free_input(r, value, ty) {
+            Some(index) => {
+                self.put(r, index, value);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The stored values and the outputs kept with the state, as in [`Slave::get`].
+    #[inline(always)]
+    fn get_quietly(&self, r: u32, ty: vars::VarType) -> Option<f64> {
+        self.loaded(self.sim.as_ref(), r, ty)
+    }
+
     fn set_input_derivatives(
         &mut self,
         vrs: &[u32],

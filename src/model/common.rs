@@ -1,7 +1,9 @@
 //! The parameters every model shares: the tanks, the amplitude laws, the initial condition.
 
 use super::{Parameters, choice};
-use crate::description::{AmplitudeModeItem, DampingLawItem, vr};
+use crate::description::{
+    AmplitudeModeItem, DampingLawItem, ModelKindItem, ScreensResponseItem, vr,
+};
 use crate::physics::geometry::Tank;
 use crate::physics::laws::{DampingLaw, LambdaRange, boundary_layer_zeta};
 use crate::physics::screens::Arrangement;
@@ -78,6 +80,8 @@ impl Common {
                 boundary: boundary(),
                 per_response: screens
                     .zeta_per_response(tank.length, tank.fundamental().mass / tank.liquid_mass()),
+                random: choice::<ScreensResponseItem>(p, vr::SCREENS_RESPONSE)?
+                    == ScreensResponseItem::Random,
             },
         };
         let amplitude = match choice(p, vr::AMPLITUDE)? {
@@ -87,6 +91,16 @@ impl Common {
                 prior: p.value(vr::A_E),
             },
         };
+        if let DampingLaw::Screens { random: true, .. } = damping
+            && matches!(amplitude, AmplitudeSource::Tracked { .. })
+            && choice::<ModelKindItem>(p, vr::MODEL)? != ModelKindItem::ShallowWater
+        {
+            return Err(
+                "screens.response = Random takes A_e as the design rms response sigma_X \
+                 of slosh.x: set amplitude = Fixed (Tracked estimates a harmonic base amplitude)"
+                    .into(),
+            );
+        }
         let common = Common {
             tank,
             tanks: p.count(vr::TANKS),

@@ -358,6 +358,7 @@ fn per_step(model: &AnyModel) -> [f64; 3] {
 
 mod cells;
 mod continuous;
+mod events;
 mod tracked;
 pub use continuous::Unknown;
 

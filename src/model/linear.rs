@@ -8,6 +8,9 @@ use crate::description::{limits, vr};
 use crate::physics::geometry::NaturalMode;
 use crate::physics::linear::{ModalOscillator, ModeState};
 
+mod continuous;
+pub use continuous::ME_MODES;
+
 /// Numbers saved after the modes' states: the integrator memory of the state format, unused.
 const CARRIED: usize = 3;
 

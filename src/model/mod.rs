@@ -6,6 +6,7 @@
 mod common;
 pub mod continuous;
 mod damper;
+pub mod events;
 mod parameters;
 mod rates;
 mod registry;

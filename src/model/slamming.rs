@@ -12,6 +12,9 @@ use crate::physics::laws::nsd_kappa;
 use crate::physics::linear::{ModalOscillator, ModeState};
 use crate::physics::slamming::{SlamState, Slamming};
 
+mod continuous;
+pub use continuous::{Event, ImpactTangent, REACH};
+
 /// Numbers of the impact mass's state in a saved state, and the unused integrator memory after.
 const IMPACT_STATE: usize = 6;
 const CARRIED: usize = 3;

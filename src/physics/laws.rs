@@ -31,8 +31,13 @@ pub enum DampingLaw {
     BoundaryLayer(f64),
     /// Damping screens (MODEL.md 9): the boundary layers' zeta plus the screens' equivalent
     /// damping zeta_s = per_response X at the resonant response X = A_e/(2 zeta)
-    /// ([`crate::physics::screens::resonant_zeta`]).
-    Screens { boundary: f64, per_response: f64 },
+    /// ([`crate::physics::screens::resonant_zeta`]); `random`: in random response of standard
+    /// deviation A_e instead ([`crate::physics::screens::random_zeta`]).
+    Screens {
+        boundary: f64,
+        per_response: f64,
+        random: bool,
+    },
 }
 
 /// Damping ratio of the fundamental mode by the laminar boundary layers on the bottom and the
@@ -48,7 +53,7 @@ impl DampingLaw {
     /// Whether [`DampingLaw::zeta`] depends on the amplitude (only then must a tracked
     /// amplitude be known before each step).
     pub fn reads_amplitude(&self) -> bool {
-        matches!(self, DampingLaw::Nsd { .. })
+        matches!(self, DampingLaw::Nsd { .. } | DampingLaw::Screens { .. })
     }
 
     /// Damping ratio for the excitation amplitude `a_e` in a tank of length `length`.
@@ -60,7 +65,13 @@ impl DampingLaw {
             DampingLaw::Screens {
                 boundary,
                 per_response,
+                random: false,
             } => crate::physics::screens::resonant_zeta(boundary, per_response, a_e),
+            DampingLaw::Screens {
+                boundary,
+                per_response,
+                random: true,
+            } => crate::physics::screens::random_zeta(boundary, per_response, a_e),
         }
     }
 }

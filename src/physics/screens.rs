@@ -140,6 +140,19 @@ pub fn resonant_zeta(boundary: f64, per_response: f64, a_e: f64) -> f64 {
     0.5 * (boundary + (boundary * boundary + 2.0 * per_response * a_e).sqrt())
 }
 
+/// The random form's factor (MODEL.md 11): zeta_s = K X for a sinusoid of amplitude X becomes
+/// zeta_s = 3 sqrt(pi/8) K sigma = 1.880 K sigma for Gaussian narrow-band response of standard
+/// deviation sigma (E|u|^3 / E[u^2] = 2 sqrt(2/pi) sigma against (8/(3 pi)) U).
+pub const RANDOM_SCREENS: f64 = 1.879_971_205_973_250_3;
+
+/// The damping ratio of a mode with amplitude-independent damping `boundary` and screens of
+/// `per_response` (zeta_s = per_response X for a sinusoid) in stationary Gaussian narrow-band
+/// response of standard deviation `sigma`: boundary + 1.880 per_response sigma.
+pub fn random_zeta(boundary: f64, per_response: f64, sigma: f64) -> f64 {
+    let sigma = if sigma.is_finite() { sigma.abs() } else { 0.0 };
+    boundary + RANDOM_SCREENS * per_response * sigma
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -55,3 +55,61 @@ pub fn tracked(name: &str) -> Instance {
     assert_eq!(inst.exit(), OK);
     inst
 }
+
+/// A Model Exchange (`me`) or Co-Simulation instance after fmi2SetupExperiment, with the
+/// Integer and Real parameters given, in initialisation mode.
+pub fn configured(name: &str, me: bool, integers: &[(u32, i32)], reals: &[(u32, f64)]) -> Instance {
+    let inst = if me {
+        Instance::model_exchange(name)
+    } else {
+        Instance::new(name)
+    };
+    assert_eq!(inst.setup(), OK);
+    for &(r, v) in integers {
+        assert_eq!(inst.set_integer(r, v), OK, "{r}");
+    }
+    for &(r, v) in reals {
+        assert_eq!(inst.set_real(r, v), OK, "{r}");
+    }
+    assert_eq!(inst.enter(), OK);
+    inst
+}
+
+/// The Real outputs' value references, from the model description: every one of them.
+pub fn real_outputs() -> Vec<u32> {
+    use tld_fmu::fmi::vars::{Causality, VARIABLES, VarType};
+    VARIABLES
+        .iter()
+        .filter(|v| v.causality == Causality::Output && v.ty == VarType::Real)
+        .map(|v| v.vr)
+        .collect()
+}
+
+/// J's column for the known `known` (fmi2GetDirectionalDerivative with the direction 1) for
+/// the `unknowns`, at the current states and inputs; the call must succeed.
+pub fn jacobian_column(inst: &Instance, unknowns: &[u32], known: u32) -> Vec<f64> {
+    let mut j = vec![f64::NAN; unknowns.len()];
+    // SAFETY: our instance, arrays of the lengths given.
+    let s = unsafe {
+        inst.lib.fmi2GetDirectionalDerivative(
+            inst.c,
+            unknowns.as_ptr(),
+            unknowns.len(),
+            &known,
+            1,
+            &1.0,
+            j.as_mut_ptr(),
+        )
+    };
+    assert_eq!(s, OK, "{:?}", inst.logs());
+    j
+}
+
+/// The value reference of the variable `name`, which must exist.
+pub fn vr_of(name: &str) -> u32 {
+    tld_fmu::fmi::vars::VARIABLES
+        .iter()
+        .find(|v| v.name == name)
+        .map(|v| v.vr)
+        .unwrap_or_else(|| panic!("no variable {name}"))
+}

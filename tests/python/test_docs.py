@@ -14,7 +14,7 @@ MODEL_MD = REPO / "docs" / "MODEL.md"
 
 def variable_table(text: str) -> dict[str, str]:
     """{variable: unit} from the rows "| `name` | unit | meaning |" of a Markdown text."""
-    return {m.group(1): m.group(2) for m in re.finditer(r"^\| `([\w.()]+)` \| ([^|]+?) \|", text, re.M)}
+    return {m.group(1): m.group(2) for m in re.finditer(r"^\| `([\w.()\[\]]+)` \| ([^|]+?) \|", text, re.M)}
 
 
 def xml_unit(v) -> str:

@@ -110,9 +110,13 @@ def test_model_structure(model_description):
             assert deps[n] == set(), f"{n} declared to depend on {deps[n]}"
     # Model Exchange: the rest of each output's dependencies are continuous states
     states = {d.variable.derivative.name for d in model_description.derivatives}
-    assert states == {"slosh.x", "slosh.v", "energy.input", "energy.dissipated"}
+    bank = {f"mode[{n}].{q}" for n in range(2, 11) for q in "xv"}
+    assert states == {"slosh.x", "slosh.v", "energy.input", "energy.dissipated", "impact.z",
+                      "impact.v"} | bank
     assert all(d - inputs <= states for d in all_deps.values())
-    assert all_deps["force"] == {"slosh.x", "slosh.v"}
+    # The Linear model's force sums its modes.
+    assert all_deps["force"] == {"slosh.x", "slosh.v"} | bank
+    assert model_description.numberOfEventIndicators == 2
 
 
 GEOMETRIES = [

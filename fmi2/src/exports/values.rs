@@ -3,9 +3,12 @@
 
 use fmi_sys::fmi2::*;
 
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
 use super::{guard, host_slice, host_slice_mut};
 use crate::calls::{self, Call};
 use crate::description::VarType;
+use crate::host::valid_array;
 use crate::instance::Instance;
 use crate::slave::Slave;
 use crate::status::{Reply, Status, refuse};
@@ -57,9 +60,69 @@ impl Access for Booleans {
     }
 }
 
-/// fmi2Get{Real,Integer,Boolean}.
+/// Our instance behind `c` if `call` passes quietly on it (its phase allows the call, no call
+/// logging) with `n` > 0 values in valid host arrays `vr` and `value`: what the quick paths of
+/// `get` and `set` assume.
+///
+/// # Safety
+/// `c` as for [`Instance::from_ptr`].
+#[inline(always)]
+unsafe fn quiet<'a, S: Slave, R, V>(
+    c: fmi2Component,
+    call: &Call,
+    vr: *const R,
+    n: usize,
+    value: *const V,
+) -> Option<&'a mut Instance<S>> {
+    // SAFETY: per the contract above.
+    let inst = unsafe { Instance::<S>::from_ptr(c) }?;
+    let quiet = n > 0 && inst.passes_quietly(call) && valid_array(vr, n) && valid_array(value, n);
+    quiet.then_some(inst)
+}
+
+/// fmi2Get{Real,Integer,Boolean}: the quick path ([`Slave::get_quietly`]) when every value is
+/// a load and the call passes quietly, else the full one. The quick path needs no saved
+/// registers and no reply to carry: the full one is a call away.
 #[inline(always)]
 unsafe fn get<S: Slave, A: Access>(
+    c: fmi2Component,
+    call: &'static Call,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut A::Host,
+) -> fmi2Status {
+    // SAFETY: the host's component and arrays, checked there.
+    if let Some(inst) = unsafe { quiet::<S, _, _>(c, call, vr, nvr, value) } {
+        // SAFETY: host arrays of nvr elements, checked above.
+        let (vrs, out) = unsafe {
+            (
+                std::slice::from_raw_parts(vr, nvr),
+                std::slice::from_raw_parts_mut(value, nvr),
+            )
+        };
+        // A panic (none is expected) is left to the full path, which catches it.
+        let quietly = |r| catch_unwind(AssertUnwindSafe(|| inst.slave.get_quietly(r, A::TYPE)));
+        let mut done = true;
+        for (slot, &r) in out.iter_mut().zip(vrs) {
+            match quietly(r) {
+                Ok(Some(v)) => *slot = A::to_host(v),
+                _ => {
+                    done = false;
+                    break;
+                }
+            }
+        }
+        if done {
+            return Status::Ok as fmi2Status;
+        }
+    }
+    // SAFETY: the host's arguments, as handed over.
+    unsafe { get_in_full::<S, A>(c, call, vr, nvr, value) }
+}
+
+/// fmi2Get{Real,Integer,Boolean}, every case.
+#[inline(never)]
+unsafe fn get_in_full<S: Slave, A: Access>(
     c: fmi2Component,
     call: &'static Call,
     vr: *const fmi2ValueReference,
@@ -79,9 +142,36 @@ unsafe fn get<S: Slave, A: Access>(
     })
 }
 
-/// fmi2Set{Real,Integer,Boolean}.
+/// fmi2Set{Real,Integer,Boolean}: the quick path ([`Slave::set_quietly`]) for one value the
+/// slave takes as it is, in a call that passes quietly (the per-step input), else the full one.
 #[inline(always)]
 unsafe fn set<S: Slave, A: Access>(
+    c: fmi2Component,
+    call: &'static Call,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const A::Host,
+) -> fmi2Status {
+    // SAFETY: as in `get`.
+    if nvr == 1
+        && let Some(inst) = unsafe { quiet::<S, _, _>(c, call, vr, nvr, value) }
+    {
+        // SAFETY: host arrays of one element, checked above.
+        let (r, v) = unsafe { (*vr, A::from_host(*value)) };
+        // A panic (none is expected) is left to the full path, which catches it.
+        let done = catch_unwind(AssertUnwindSafe(|| inst.slave.set_quietly(r, v, A::TYPE)))
+            .unwrap_or(false);
+        if done {
+            return Status::Ok as fmi2Status;
+        }
+    }
+    // SAFETY: the host's arguments, as handed over.
+    unsafe { set_in_full::<S, A>(c, call, vr, nvr, value) }
+}
+
+/// fmi2Set{Real,Integer,Boolean}, every case.
+#[inline(never)]
+unsafe fn set_in_full<S: Slave, A: Access>(
     c: fmi2Component,
     call: &'static Call,
     vr: *const fmi2ValueReference,

@@ -130,6 +130,26 @@ fn wind_design_meets_its_targets_and_holds_the_rms() {
     };
     let (sx, sd) = two.white_noise_rms(s0).expect("stable");
     assert!((d.sloshing / sd - 1.880).abs() < 1e-3 && d.predicted == sx);
+    // The FMU's mechanical models with the law's random form at A_e = that rms (the report's
+    // parameter line) damp the tanks by zeta_opt.
+    let mechanical = d
+        .parameters(24)
+        .with(vr::MODEL, ModelKindItem::Linear as i64 as f64)
+        .with(
+            vr::SCREENS_RESPONSE,
+            crate::description::ScreensResponseItem::Random as i64 as f64,
+        )
+        .with(
+            vr::A_E,
+            d.sloshing / crate::physics::screens::RANDOM_SCREENS,
+        );
+    let (common, _) = crate::model::Common::read(&mechanical).expect("parameters");
+    let zeta = common.zeta(d.sloshing / crate::physics::screens::RANDOM_SCREENS);
+    assert!(
+        (zeta / d.zeta_opt - 1.0).abs() < 1e-9,
+        "{zeta} vs {}",
+        d.zeta_opt
+    );
     let h = 1.0 / s.frequency / 64.0;
     let count = (1600.0 / h) as usize;
     let f = wind_force(s0, (0.3 * s.omega(), 3.0 * s.omega()), h, count, 1);

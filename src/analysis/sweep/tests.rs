@@ -441,6 +441,7 @@ fn screens_law(p: &StartValues) -> (crate::model::Common, f64, f64) {
     let crate::physics::laws::DampingLaw::Screens {
         boundary,
         per_response,
+        ..
     } = common.damping
     else {
         panic!("not the Screens law")

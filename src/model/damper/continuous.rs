@@ -5,7 +5,7 @@
 //! host's solver has none; it is refused with that reason.
 
 use super::{Damper, per_step};
-use crate::model::continuous::{Direction, STATES};
+use crate::model::continuous::{BANK, Direction, IMPACT_V, IMPACT_Z, STATES, Tangent};
 use crate::model::{AmplitudeSource, Inputs, Output};
 
 /// What a directional derivative asks for: a state's derivative (in state order) or an output.
@@ -23,7 +23,8 @@ impl Damper {
         self.model.offers_model_exchange()
     }
 
-    /// The continuous states [slosh.x, slosh.v, energy.input, energy.dissipated].
+    /// The continuous states [slosh.x, slosh.v, energy.input, energy.dissipated, impact.z,
+    /// impact.v].
     pub fn continuous_states(&self) -> [f64; STATES] {
         self.model.continuous_states(self.initial_energy)
     }
@@ -31,12 +32,14 @@ impl Damper {
     /// Take the continuous states (finite); all or nothing.
     pub fn set_continuous_states(&mut self, s: &[f64; STATES]) -> Result<(), String> {
         let limit = 100.0 * self.common.tank.length;
-        if s[0].abs() > limit {
-            return Err(format!(
-                "slosh.x = {:e} m ran away beyond {limit} m (100 tank lengths): the host's step \
-                 is too large, or the input is not in m/s^2",
-                s[0]
-            ));
+        for (k, name) in [(0, "slosh.x"), (IMPACT_Z, "impact.z")] {
+            if s[k].abs() > limit {
+                return Err(format!(
+                    "{name} = {:e} m ran away beyond {limit} m (100 tank lengths): the host's \
+                     step is too large, or the input is not in m/s^2",
+                    s[k]
+                ));
+            }
         }
         let mut model = self.model.clone();
         model.set_continuous_states(s, self.initial_energy)?;
@@ -51,12 +54,23 @@ impl Damper {
     }
 
     /// Nominal magnitudes of the states: half a tank length, the velocity of that amplitude at
-    /// the sloshing frequency, and the energy of that motion.
+    /// the sloshing frequency, and the energy of that motion (the impact mass's as the
+    /// sloshing mass's).
     pub fn continuous_nominals(&self) -> [f64; STATES] {
         let x = 0.5 * self.common.tank.length;
         let v = self.derived.omega_f * x;
         let energy = (0.5 * self.derived.mass_slosh * v * v).max(f64::MIN_POSITIVE);
-        [x, v, energy, energy]
+        let mut n = [x; STATES];
+        n[1] = v;
+        n[2] = energy;
+        n[3] = energy;
+        n[IMPACT_Z] = x;
+        n[IMPACT_V] = v;
+        // The bank of higher modes: (x, v) pairs.
+        for pair in n[BANK..].chunks_exact_mut(2) {
+            pair[1] = v;
+        }
+        n
     }
 
     /// J d: the exact change of each of `unknowns` for the change `d` of the states and inputs
@@ -85,7 +99,7 @@ impl Damper {
                 Unknown::Derivative(k) => *t.derivatives.get(k).ok_or_else(|| {
                     format!("there are {STATES} state derivatives, not {}", k + 1)
                 })?,
-                Unknown::Output(which) => self.output_tangent(which, d, t.force, t.stored)?,
+                Unknown::Output(which) => self.output_tangent(which, d, &t)?,
                 Unknown::Frozen => 0.0,
             });
         }
@@ -93,15 +107,10 @@ impl Damper {
         Ok(())
     }
 
-    /// J d of the output `which` (as [`Damper::output`] forms it), given the force's and the
-    /// stored energy's.
-    fn output_tangent(
-        &self,
-        which: Output,
-        d: &Direction,
-        force: f64,
-        stored: f64,
-    ) -> Result<f64, String> {
+    /// J d of the output `which` (as [`Damper::output`] forms it), given the model's tangent
+    /// (of the force, the stored energy, impact.z).
+    fn output_tangent(&self, which: Output, d: &Direction, t: &Tangent) -> Result<f64, String> {
+        let (force, stored, impact_z) = (t.force, t.stored, t.impact_z);
         Ok(match which {
             Output::X => d.states[0],
             Output::V => d.states[1],
@@ -120,8 +129,9 @@ impl Damper {
             Output::EnergyInput => d.states[2],
             Output::EnergyDissipated => d.states[3],
             Output::EnergyStored => stored,
-            // Fixed amplitude and damping; no impacts in the offered models.
-            Output::Amplitude | Output::Zeta | Output::ImpactZ | Output::Impacts => 0.0,
+            Output::ImpactZ => impact_z,
+            // Fixed amplitude and damping; the count of impacts changes at events only.
+            Output::Amplitude | Output::Zeta | Output::Impacts => 0.0,
             Output::SurfaceLeft | Output::SurfaceRight => {
                 if self.model.surface().is_some() {
                     return Err(format!("{which:?} of a model that resolves the surface"));

@@ -113,7 +113,7 @@ impl Slamming {
     /// While resting on `wall`, the first time in (s0, s1] at which the base acceleration stops
     /// pressing the mass onto it (a_b wall > 0), or None.
     fn release(b: &BaseAcceleration, wall: i8, s0: f64, s1: f64) -> Option<f64> {
-        let pulls = |s: f64| b.at(s) * f64::from(wall) > 0.0;
+        let pulls = |s: f64| !pressed(wall, b.at(s));
         if pulls(s0) {
             return Some(s0);
         }
@@ -135,6 +135,27 @@ impl Slamming {
             lo = hi;
         }
         None
+    }
+
+    /// The impact law (Eq 2.5 with the tank as the infinitely heavy partner, MODEL.md section
+    /// 3) at the instant the mass reaches `wall` (+1 or -1) with relative velocity `v_hit`
+    /// under base acceleration `a`: the mass rebounds with -e v_hit from the wall, or comes to
+    /// rest on it if that rebound is slower than `rest_speed` while `a` presses it there. Counts
+    /// the impact and its dissipated energy; returns the impulse given to the tank per unit
+    /// mass, v_hit - v_after [m/s].
+    pub fn hit(&self, st: &mut SlamState, wall: i8, v_hit: f64, a: f64) -> f64 {
+        let mut v_after = -self.restitution * v_hit;
+        st.z = f64::from(wall) * 0.5 * self.clearance;
+        st.impacts += 1;
+        if v_after.abs() < self.rest_speed && pressed(wall, a) {
+            // The rebound is negligible: the mass comes to rest on the wall.
+            v_after = 0.0;
+            st.contact = wall;
+        }
+        // The tank takes the momentum the water loses; the energy is dissipated.
+        st.dissipated += 0.5 * (v_hit * v_hit - v_after * v_after);
+        st.v = v_after;
+        v_hit - v_after
     }
 
     /// Advance the impact mass by `h` under `base` (local time 0..h). Returns the impulse the
@@ -173,25 +194,13 @@ impl Slamming {
                 Some((t_hit, wall)) => {
                     let (_, v_hit) = Self::flight(base, next.z, next.v, s, t_hit);
                     next.work_in += 0.5 * (v_hit * v_hit - v_start * v_start);
-                    let mut v_after = -self.restitution * v_hit;
-                    next.z = f64::from(wall) * half;
-                    next.impacts += 1;
                     impacts += 1;
                     if impacts > MAX_IMPACTS_PER_STEP {
                         return Err(format!(
                             "more than {MAX_IMPACTS_PER_STEP} impacts in one step: chattering did not end"
                         ));
                     }
-                    let pressed = base.at(t_hit) * f64::from(wall) <= 0.0;
-                    if v_after.abs() < self.rest_speed && pressed {
-                        // The rebound is negligible: the mass comes to rest on the wall.
-                        v_after = 0.0;
-                        next.contact = wall;
-                    }
-                    // The tank takes the momentum the water loses; the energy is dissipated.
-                    impulse += v_hit - v_after;
-                    next.dissipated += 0.5 * (v_hit * v_hit - v_after * v_after);
-                    next.v = v_after;
+                    impulse += self.hit(&mut next, wall, v_hit, base.at(t_hit));
                     s = t_hit;
                 }
             }
@@ -199,6 +208,12 @@ impl Slamming {
         *st = next;
         Ok(impulse)
     }
+}
+
+/// Whether base acceleration `a` presses the mass onto `wall` (+1 or -1): its acceleration
+/// relative to the tank, -a, points into that wall (or vanishes).
+pub fn pressed(wall: i8, a: f64) -> bool {
+    a * f64::from(wall) <= 0.0
 }
 
 /// A bound of abs(a_b) over [s0, s1]: the polynomial is about b.t0, so its terms grow with the

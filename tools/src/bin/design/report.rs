@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use std::time::Duration;
 
 use tld_fmu::analysis::design::{Excitation, Structure};
+use tld_fmu::physics::screens::RANDOM_SCREENS;
 
 use crate::{Args, Case, Check, Designed};
 
@@ -266,13 +267,21 @@ fn report(r: &Run) -> String {
     for (q, v) in rows {
         let _ = writeln!(out, "| {q} | {v} |");
     }
+    // The mechanical models' law: for wind its random form at the tuned mass's rms (MODEL.md
+    // 11), otherwise the resonant form at the equivalent base amplitude.
+    let mechanical = match &d.excitation {
+        Excitation::Wind { .. } => format!(
+            "screens.response = Random, amplitude = Fixed, A_e = sigma_X = {:.4e}",
+            g.sloshing / RANDOM_SCREENS
+        ),
+        _ => format!("amplitude = Fixed, A_e = {:.4e}", g.amplitude),
+    };
     let _ = writeln!(
         out,
         "\nTLD.fmu parameters: model = ShallowWater (or a mechanical model with damping = \
-         Screens, amplitude = Fixed, A_e = {:.4e}), tank.length = {:.4}, tank.breadth = {:.4}, \
+         Screens, {mechanical}), tank.length = {:.4}, tank.breadth = {:.4}, \
          tank.depth = {:.4}, tanks = {}, screens.count = {}, screens.solidity = {:.4}, \
          screens.spacing = {:.4}.\n",
-        g.amplitude,
         t.length,
         t.breadth,
         t.depth,
