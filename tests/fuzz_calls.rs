@@ -17,7 +17,7 @@ fn random_call_sequences_keep_the_invariants() {
         .iter()
         .map(|m| m.value() as i32)
         .collect();
-    // amplitude Fixed (1) or Tracked (2): Model Exchange runs with Fixed only.
+    // amplitude Fixed (1) or Tracked (2), both offered in Model Exchange.
     let model = (proptest::sample::select(models), 1..=2i32).prop_map(|(model, amplitude)| {
         Call::SetInteger {
             vrs: vec![vr::MODEL, vr::AMPLITUDE],
@@ -27,7 +27,7 @@ fn random_call_sequences_keep_the_invariants() {
     let target = Target {
         value_references: VARIABLES.iter().map(|v| v.vr).collect(),
         output: vr::FORCE,
-        states: 24,
+        states: tld_fmu::model::continuous::ALL_STATES,
     };
     fuzz::run(target, fuzz::starting_with(model));
 }

@@ -13,7 +13,8 @@ use tld_fmu::fmi::vars::vr;
 
 /// The states perturbed here (those of the oscillator models), of all the continuous states.
 const N: usize = 4;
-const STATES: usize = 24;
+/// All continuous states: these models use the first four (the rest are frozen at 0).
+const STATES: usize = tld_fmu::model::continuous::ALL_STATES;
 const LINEAR: i32 = 1;
 const NONLINEAR: i32 = 2;
 const AUTO: i32 = 4;

@@ -10,7 +10,8 @@ mod common;
 use common::*;
 use tld_fmu::fmi::vars::{VARIABLES, vr};
 
-const N: usize = 24;
+/// All continuous states (the amplitude estimator's and the ShallowWater cells after these, 0 here).
+const N: usize = tld_fmu::model::continuous::ALL_STATES;
 const DT: f64 = 0.01;
 
 fn linear(name: &str, me: bool, modes: i32) -> Instance {
@@ -87,7 +88,8 @@ fn a_host_integrates_ten_modes_to_the_exact_solution() {
     }
     // The bank beyond the model's modes: none here; all modes are moving.
     let (_, x) = me.states(N);
-    assert!(x[6..].iter().all(|v| *v != 0.0), "{x:?}");
+    let modes = tld_fmu::model::continuous::STATES;
+    assert!(x[6..modes].iter().all(|v| *v != 0.0), "{x:?}");
 }
 
 /// Fewer modes: the bank's pairs beyond them stay 0 with derivative 0; more than ten modes are

@@ -14,7 +14,8 @@ use tld_fmu::fmi::vars::vr;
 
 /// Continuous states: slosh.x, slosh.v, energy.input, energy.dissipated, impact.z, impact.v,
 /// the Linear model's bank of higher modes (0 here).
-const N: usize = 24;
+/// All continuous states (the amplitude estimator's and the ShallowWater cells after these, 0 here).
+const N: usize = tld_fmu::model::continuous::ALL_STATES;
 /// Those S^2 uses.
 const S2_STATES: usize = 6;
 const S2_NAMES: [&str; S2_STATES] = [

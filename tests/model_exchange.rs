@@ -9,8 +9,9 @@ use common::*;
 use tld_fmu::fmi::vars::vr;
 
 /// Continuous states of TLD.fmu in ME: slosh.x, slosh.v, energy.input, energy.dissipated,
-/// impact.z, impact.v, and the Linear model's mode[n].x, mode[n].v (n = 2..10).
-const N: usize = 24;
+/// impact.z, impact.v, the Linear model's mode[n].x, mode[n].v (n = 2..10), the amplitude
+/// estimator's 7 and the ShallowWater cell bank (frozen at 0 where unused).
+const N: usize = tld_fmu::model::continuous::ALL_STATES;
 /// Items: model = Linear (1), Nonlinear (2), SloshingSlamming (3); damping Constant (1);
 /// amplitude Fixed (1).
 const LINEAR: i32 = 1;
@@ -145,7 +146,7 @@ fn calls_out_of_order_say_what_to_call_first() {
         "fmi2DoStep is not allowed in state EventMode",
         "fmi2CoSimulation",
         "Call fmi2EnterEventMode first",
-        "the model description declares 24",
+        "the model description declares 431",
         "state 1 is NaN",
         "ran away",
     ] {
@@ -167,19 +168,41 @@ fn calls_out_of_order_say_what_to_call_first() {
 #[test]
 fn a_model_not_offered_says_why_and_another_can_be_chosen() {
     let inst = in_initialisation("me-shallow", SHALLOW_WATER, 0.0);
+    // More cells than the bank the model description declares.
+    assert_eq!(inst.set_integer(vr::SWE_CELLS, 201), OK);
     assert_eq!(inst.exit(), ERROR);
     assert!(
-        inst.logs().join("\n").contains("swe.cells"),
+        inst.logs().join("\n").contains("swe.cells = 201"),
         "{:?}",
         inst.logs()
     );
     assert_eq!(inst.derivatives(N).0, ERROR);
     assert_eq!(inst.set_integer(vr::MODEL, NONLINEAR), OK);
     assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
+    // amplitude = Tracked is offered (its estimator's states follow the host's solution), but
+    // has no directional derivatives: said so.
     let tracked = in_initialisation("me-tracked", NONLINEAR, 0.0);
     assert_eq!(tracked.set_integer(vr::AMPLITUDE, 2), OK);
-    assert_eq!(tracked.exit(), ERROR);
-    assert!(tracked.logs().join("\n").contains("amplitude = Tracked"));
+    assert_eq!(tracked.exit(), OK, "{:?}", tracked.logs());
+    let mut out = [0.0];
+    let status = unsafe {
+        tracked.lib.fmi2GetDirectionalDerivative(
+            tracked.c,
+            [vr::DER_SLOSH_V_].as_ptr(),
+            1,
+            [vr::SLOSH_X].as_ptr(),
+            1,
+            [1.0].as_ptr(),
+            out.as_mut_ptr(),
+        )
+    };
+    assert_eq!(status, ERROR);
+    assert!(
+        tracked
+            .logs()
+            .join("\n")
+            .contains("amplitude = Tracked has no directional")
+    );
 }
 
 /// An FMU state saved in continuous-time mode restores (in this and in a new ME instance, from
@@ -259,7 +282,8 @@ fn instantiating_for_model_exchange_says_what_is_offered() {
     for part in [
         "Linear (modes <= 10)",
         "SloshingSlamming (impacts as state events)",
-        "ShallowWater, Linear with more modes and amplitude = Tracked",
+        "ShallowWater (swe.cells <= 200)",
+        "amplitude = Fixed or Tracked",
     ] {
         assert!(said.contains(part), "no '{part}' in: {said}");
     }

@@ -6,13 +6,17 @@
 
 use fmi2_slave::{Context, Continuous, EventUpdate, Refusal, Reply, Status, refuse};
 
+use super::me_cells::{Cell, cell_of, tracker_of};
+
 use super::params::output_of;
 use super::slave::Tld;
 use super::vars::{VARIABLES, VarType, index_of, vr};
-use crate::model::continuous::{BANK, Direction, STATES};
+use crate::model::continuous::{ALL_STATES, BANK, Direction, STATES};
 use crate::model::events::EVENT_INDICATORS;
+use crate::model::shallow_water::continuous::{CELL_STATES, StatesRefused};
 use crate::model::slamming::Event;
 use crate::model::{Damper, Unknown};
+use crate::physics::amplitude::TRACKER_CONTINUOUS;
 
 /// The state derivative variables, in state order.
 const DERIVATIVES: [u32; STATES] = with_bank(
@@ -68,6 +72,12 @@ fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
             vr::BASE_X => &mut d.x,
             _ => match STATE_VARIABLES.iter().position(|&s| s == r) {
                 Some(k) => &mut d.states[k],
+                // A cell: no equation of a model without cells reads it (and a model with cells
+                // has no directional derivatives).
+                None if matches!(cell_of(r), Some(Cell::State(_))) => continue,
+                // The estimator's: read by no equation with a fixed amplitude (and a tracked
+                // one has no directional derivatives).
+                None if matches!(tracker_of(r), Some((_, false))) => continue,
                 None => {
                     return Err(refuse(format!(
                         "fmi2GetDirectionalDerivative: value reference {r} is neither a \
@@ -87,6 +97,9 @@ fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
 fn unknown(r: u32) -> Result<Unknown, Refusal> {
     if let Some(k) = DERIVATIVES.iter().position(|&d| d == r) {
         return Ok(Unknown::Derivative(k));
+    }
+    if let (Some(Cell::Derivative(_)), _) | (_, Some((_, true))) = (cell_of(r), tracker_of(r)) {
+        return Ok(Unknown::Frozen);
     }
     let real = index_of(r).is_some_and(|k| VARIABLES[k].ty == VarType::Real);
     match output_of(r) {
@@ -126,8 +139,9 @@ impl Tld {
 }
 
 impl Tld {
-    /// The value of a state derivative variable (der(slosh.x), ...) or of a state that is no
-    /// output (impact.v), if `r` names one.
+    /// The value of a state derivative variable (der(slosh.x), ...), of a state that is no
+    /// output (impact.v), or of the amplitude estimator's or a cell's state or derivative, if
+    /// `r` names one.
     pub(super) fn derivative_value(
         &self,
         context: &Context,
@@ -136,7 +150,15 @@ impl Tld {
         // Ok(k): the derivative of state k; Err(k): state k.
         let which = match DERIVATIVES.iter().position(|&d| d == r) {
             Some(k) => Ok(k),
-            None => Err(STATE_VARIABLES.iter().position(|&s| s == r)?),
+            None => match STATE_VARIABLES.iter().position(|&s| s == r) {
+                Some(k) => Err(k),
+                None => {
+                    if let Some((k, derivative)) = tracker_of(r) {
+                        return Some(self.tracker_value(context, k, derivative));
+                    }
+                    return self.cell_value(context, cell_of(r)?);
+                }
+            },
         };
         // Before initialisation (hosts read the initial unknowns in initialisation mode): from
         // the simulation the parameters set so far would start.
@@ -152,15 +174,54 @@ impl Tld {
     }
 }
 
+impl Tld {
+    /// The estimator's state or derivative `k` (0 with a fixed amplitude).
+    fn tracker_value(&self, context: &Context, k: usize, derivative: bool) -> Result<f64, Refusal> {
+        let mut provisional = None;
+        let inputs = self.values.inputs([0.0; 2]);
+        let mut out = [0.0; TRACKER_CONTINUOUS];
+        let sim = self.simulation(context, &mut provisional)?;
+        if derivative {
+            sim.tracker_derivatives(&inputs, &mut out);
+        } else {
+            sim.tracker_states(&mut out);
+        }
+        Ok(out[k])
+    }
+
+    /// A cell's state or derivative (0 for a model without cells).
+    fn cell_value(&self, context: &Context, cell: Cell) -> Option<Result<f64, Refusal>> {
+        let mut provisional = None;
+        let inputs = self.values.inputs([0.0; 2]);
+        let mut bank = [0.0; CELL_STATES];
+        Some(
+            self.simulation(context, &mut provisional)
+                .map(|sim| match cell {
+                    Cell::State(k) => {
+                        sim.cell_states(&mut bank);
+                        bank[k]
+                    }
+                    Cell::Derivative(k) => {
+                        sim.cell_derivatives(&inputs, &mut bank);
+                        bank[k]
+                    }
+                }),
+        )
+    }
+}
+
 impl Continuous for Tld {
-    const STATES: usize = STATES;
+    const STATES: usize = ALL_STATES;
     const EVENT_INDICATORS: usize = EVENT_INDICATORS;
     const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
-        "Model Exchange offers model = Linear (modes <= 10), Nonlinear, Auto and \
-         SloshingSlamming (impacts as state events) with amplitude = Fixed; the states are \
-         slosh.x, slosh.v, energy.input, energy.dissipated, impact.z, impact.v and mode[n].x, \
-         mode[n].v (n = 2..10, Linear's higher modes). ShallowWater, Linear with more modes and \
-         amplitude = Tracked are Co-Simulation only (fmi2ExitInitializationMode says why); see \
+        "Model Exchange offers model = Linear (modes <= 10), Nonlinear, Auto, \
+         SloshingSlamming (impacts as state events) and ShallowWater (swe.cells <= 200) with \
+         amplitude = Fixed or Tracked; the states are slosh.x, slosh.v, energy.input, \
+         energy.dissipated, impact.z, impact.v, mode[n].x, mode[n].v (n = 2..10, Linear's \
+         higher modes), the amplitude estimator's A_e.tracker.*, then the ShallowWater cells \
+         swe.h[i], swe.q[i] (each frozen at 0 where the configuration has none). Linear with \
+         more modes and ShallowWater with more cells are Co-Simulation only \
+         (fmi2ExitInitializationMode says why); see \
          docs/MODEL_EXCHANGE.md",
     );
 
@@ -171,30 +232,47 @@ impl Continuous for Tld {
     }
 
     fn states(&self, x: &mut [f64]) -> Reply {
-        x.copy_from_slice(&self.running("fmi2GetContinuousStates")?.continuous_states());
+        let sim = self.running("fmi2GetContinuousStates")?;
+        let (core, tracker, cells) = split(x);
+        core.copy_from_slice(&sim.continuous_states());
+        sim.tracker_states(tracker);
+        sim.cell_states(cells);
         Ok(Status::Ok)
     }
 
     fn set_states(&mut self, _: &Context, x: &[f64]) -> Reply {
-        let mut s = [0.0; STATES];
-        s.copy_from_slice(x);
+        let mut all = [0.0; ALL_STATES];
+        all.copy_from_slice(x);
+        let (s, tracker, bank) = split(&mut all);
+        let s = <&[f64; STATES]>::try_from(&*s)
+            .unwrap_or_else(|_| unreachable!("STATES long by construction"));
         let sim = self
             .sim
             .as_mut()
             .ok_or_else(|| refuse("fmi2SetContinuousStates: no simulation (not initialised)"))?;
-        sim.set_continuous_states(&s).map_err(|why| {
-            refuse(format!(
-                "fmi2SetContinuousStates: {why}; the states are left as they were"
-            ))
-        })?;
+        sim.set_all_continuous_states(s, tracker, bank)
+            .map_err(|why| {
+                let (status, why) = match why {
+                    // The host may retry with a shorter step.
+                    StatesRefused::Step(why) => (Status::Discard, why),
+                    StatesRefused::Invalid(why) => (Status::Error, why),
+                };
+                Refusal::new(
+                    status,
+                    format!("fmi2SetContinuousStates: {why}; the states are left as they were"),
+                )
+            })?;
         Ok(Status::Ok)
     }
 
     fn derivatives(&self, context: &Context, dx: &mut [f64]) -> Reply {
         let inputs = self.values.inputs([0.0; 2]);
-        let d = self
-            .running("fmi2GetDerivatives")?
-            .continuous_derivatives(&inputs);
+        let sim = self.running("fmi2GetDerivatives")?;
+        let mut d = [0.0; ALL_STATES];
+        let (core, tracker, cells) = split(&mut d);
+        core.copy_from_slice(&sim.continuous_derivatives(&inputs));
+        sim.tracker_derivatives(&inputs, tracker);
+        sim.cell_derivatives(&inputs, cells);
         copy_finite(
             "fmi2GetDerivatives",
             "derivative",
@@ -227,19 +305,29 @@ impl Continuous for Tld {
             .as_mut()
             .ok_or_else(|| refuse("fmi2NewDiscreteStates: no simulation (not initialised)"))?;
         let event = sim.event(&inputs);
+        // amplitude = Tracked: a base.v other than 0 switches the estimator (below).
+        let switched = sim.tracker_event(&inputs);
         Ok(EventUpdate {
-            states_changed: matches!(event, Event::Impact { .. }),
+            states_changed: matches!(event, Event::Impact { .. }) || switched,
             next_event: None,
         })
     }
 
     fn nominals(&self, out: &mut [f64]) -> Reply {
-        out.copy_from_slice(
-            &self
-                .running("fmi2GetNominalsOfContinuousStates")?
-                .continuous_nominals(),
-        );
+        let sim = self.running("fmi2GetNominalsOfContinuousStates")?;
+        let (core, tracker, cells) = split(out);
+        core.copy_from_slice(&sim.continuous_nominals());
+        sim.tracker_nominals(tracker);
+        sim.cell_nominals(cells);
         Ok(Status::Ok)
+    }
+
+    /// amplitude = Tracked: a base.v other than 0 switches the estimator to it (an event).
+    fn completed_step(&mut self, _: &Context) -> Result<bool, Refusal> {
+        let inputs = self.values.inputs([0.0; 2]);
+        Ok(self
+            .running("fmi2CompletedIntegratorStep")?
+            .tracker_event_pending(&inputs))
     }
 
     fn directional_derivative(
@@ -263,6 +351,27 @@ impl Continuous for Tld {
             .map_err(|why| refuse(format!("{F}: {why}")))?;
         copy_finite(F, "entry", context, inputs.a, &out, dv_unknown)
     }
+}
+
+/// The host's array of all states (the layer checked its length) as the four, the
+/// estimator's and the bank.
+#[allow(clippy::type_complexity)]
+fn split(
+    x: &mut [f64],
+) -> (
+    &mut [f64],
+    &mut [f64; TRACKER_CONTINUOUS],
+    &mut [f64; CELL_STATES],
+) {
+    let (core, rest) = x.split_at_mut(STATES);
+    let (tracker, cells) = rest.split_at_mut(TRACKER_CONTINUOUS);
+    (
+        core,
+        <&mut [f64; TRACKER_CONTINUOUS]>::try_from(tracker)
+            .unwrap_or_else(|_| unreachable!("TRACKER_CONTINUOUS long by construction")),
+        <&mut [f64; CELL_STATES]>::try_from(cells)
+            .unwrap_or_else(|_| unreachable!("the layer checks the length")),
+    )
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ mod access;
 #[cfg(test)]
 mod generated_tests;
 mod me;
+mod me_cells;
 mod params;
 mod slave;
 mod snapshot;

@@ -183,7 +183,7 @@ pub const fn source(vr: u32, ty: VarType) -> Source {
 }
 
 /// [`source`] for every value reference, read as Real.
-pub const REAL_SOURCES: [Source; VR_INDEX.len()] = {
+pub static REAL_SOURCES: [Source; VR_INDEX.len()] = {
     let mut table = [Source::Unknown; VR_INDEX.len()];
     let mut vr = 0;
     while vr < table.len() {

@@ -10,9 +10,12 @@
 //! The Linear model's modes 2 to [`ME_MODES`] are a bank of (x, v) pairs after these
 //! (`linear::continuous`); the other models keep them at 0, their derivatives 0.
 //!
-//! Not offered, with its reason: ShallowWater (its 2 x swe.cells states cannot be declared in
-//! an FMI 2.0 model description whose number of states is fixed, while swe.cells is a
-//! parameter); Linear with more than [`ME_MODES`] modes.
+//! ShallowWater is offered with swe.cells up to the bank of cells the model description
+//! declares after all these (`shallow_water::continuous`): its cells are states of their own,
+//! and x, v and dissipated are functions of them.
+//!
+//! Not offered, with its reason: ShallowWater with more cells than the bank; Linear with more
+//! than [`ME_MODES`] modes.
 //!
 //! Directional derivatives (J d, for a host's implicit solver): the exact derivatives of the
 //! same rates in the states and the base acceleration, the damping ratio fixed (amplitude =
@@ -34,6 +37,12 @@ pub const IMPACT_Z: usize = 4;
 pub const IMPACT_V: usize = 5;
 /// Where the bank of higher modes begins.
 pub const BANK: usize = 6;
+
+/// All the continuous states the model description declares: those, the amplitude
+/// estimator's (amplitude = Tracked) and the ShallowWater cell bank, in that order.
+pub const ALL_STATES: usize = STATES
+    + crate::physics::amplitude::TRACKER_CONTINUOUS
+    + super::shallow_water::continuous::CELL_STATES;
 
 /// The outputs whose rates are the states' derivatives, in state order.
 pub const RATES: [Output; 4] = [
@@ -134,12 +143,7 @@ impl AnyModel {
             | AnyModel::Nonlinear(_)
             | AnyModel::Auto(_)
             | AnyModel::SloshingSlamming(_) => Ok(()),
-            AnyModel::ShallowWater(_) => Err(
-                "model = ShallowWater is Co-Simulation only: its 2 x swe.cells states cannot be \
-                 declared in an FMI 2.0 model description, where the number of states is fixed \
-                 and swe.cells is a parameter"
-                    .into(),
-            ),
+            AnyModel::ShallowWater(m) => m.fits_model_exchange(),
         }
     }
 
@@ -264,19 +268,31 @@ mod tests {
     fn models_not_offered_say_why() {
         let why = |m: AnyModel| m.offers_model_exchange().err().unwrap_or_default();
         assert!(why(model(ModelKindItem::Linear, 11.0)).contains("modes <= 10"));
-        assert!(why(model(ModelKindItem::ShallowWater, 1.0)).contains("swe.cells"));
+        assert!(why(shallow_water(201.0)).contains("swe.cells = 201"));
+        assert!(shallow_water(200.0).offers_model_exchange().is_ok());
     }
 
     /// Nor have they a Jacobian: refused with the same reason, never numbers.
     #[test]
     fn models_not_offered_have_no_tangent() {
-        for (item, modes) in [
-            (ModelKindItem::Linear, 11.0),
-            (ModelKindItem::ShallowWater, 1.0),
-        ] {
-            let m = model(item, modes);
-            let got = m.continuous_tangent(0.1, &Direction::default());
-            assert_eq!(got.err(), m.offers_model_exchange().err(), "{item:?}");
-        }
+        let m = model(ModelKindItem::Linear, 11.0);
+        let got = m.continuous_tangent(0.1, &Direction::default());
+        assert_eq!(got.err(), m.offers_model_exchange().err());
+        let m = shallow_water(201.0);
+        let got = m.continuous_tangent(0.1, &Direction::default());
+        assert_eq!(got.err(), m.offers_model_exchange().err());
+        // Offered, but without directional derivatives (the limiter's kinks): said so.
+        let got = shallow_water(150.0).continuous_tangent(0.1, &Direction::default());
+        assert!(got.is_err_and(|why| why.contains("no directional derivatives")));
+    }
+
+    fn shallow_water(cells: f64) -> AnyModel {
+        let p = StartValues::default().with(vr::SWE_CELLS, cells);
+        let (common, _) = Common::read(&p).expect("start values are consistent");
+        let start = Start {
+            zeta: 0.02,
+            amplitude: 0.005,
+        };
+        AnyModel::configure(ModelKindItem::ShallowWater, &p, &common, start).expect("configures")
     }
 }

@@ -356,8 +356,10 @@ fn per_step(model: &AnyModel) -> [f64; 3] {
     [model.force(), x, v]
 }
 
+mod cells;
 mod continuous;
 mod events;
+mod tracked;
 pub use continuous::Unknown;
 
 #[cfg(test)]

@@ -38,6 +38,22 @@ impl<const N: usize> MeanSquare<N> {
     }
 }
 
+impl<const N: usize> MeanSquare<N> {
+    /// The filters' time derivatives under `sample`, time constant `tau`: the ODEs whose exact
+    /// solution for a held sample [`MeanSquare::update`] is.
+    fn rates(&self, tau: f64, sample: [f64; N]) -> ([f64; N], [f64; N]) {
+        (
+            std::array::from_fn(|k| (sample[k] - self.first[k]) / tau),
+            std::array::from_fn(|k| (self.first[k] - self.second[k]) / tau),
+        )
+    }
+}
+
+/// Number of values in [`AmplitudeTracker::continuous_state`]: the rebuilt velocity and the
+/// three filter pairs, the estimator as ODEs in continuous time (the velocity source, measured
+/// or rebuilt, is a discrete state).
+pub const TRACKER_CONTINUOUS: usize = 7;
+
 /// The lanes of [`AmplitudeTracker::squares`].
 const V: usize = 0;
 const A: usize = 1;
@@ -165,6 +181,61 @@ impl AmplitudeTracker {
         self.measured_v_seen = true;
         self.squares = MeanSquare::default();
         self.weight = MeanSquare::default();
+    }
+
+    /// Whether the host's base velocity `velocity` switches the estimator to it (it is not 0
+    /// and the estimator still rebuilds the velocity from the acceleration).
+    pub fn would_see_velocity(&self, velocity: f64) -> bool {
+        velocity != 0.0 && !self.measured_v_seen
+    }
+
+    /// The switch (Model Exchange's event): restart the statistics from the measured velocity,
+    /// once. True if it did.
+    pub fn sees_velocity(&mut self, velocity: f64) -> bool {
+        let switch = self.would_see_velocity(velocity);
+        if switch {
+            self.restart_measured();
+        }
+        switch
+    }
+
+    /// The estimator's continuous part: [rebuilt v, <v^2> first, second, <a^2> first, second,
+    /// weight first, second].
+    pub fn continuous_state(&self) -> [f64; TRACKER_CONTINUOUS] {
+        // The saved state without its flag (position 1).
+        let s = self.state();
+        std::array::from_fn(|k| s[if k == 0 { 0 } else { k + 1 }])
+    }
+
+    /// Take the continuous part (as [`AmplitudeTracker::continuous_state`] gives it); the
+    /// velocity source stays. Err (nothing taken) for a negative mean square or weight, which
+    /// the ODEs never reach (a step far longer than tau does).
+    pub fn set_continuous_state(&mut self, s: &[f64; TRACKER_CONTINUOUS]) -> Result<(), String> {
+        let mut saved = self.state();
+        saved[0] = s[0];
+        saved[2..].copy_from_slice(&s[1..]);
+        self.set_state(&saved)
+    }
+
+    /// The time derivatives of [`AmplitudeTracker::continuous_state`] under the base
+    /// acceleration `accel` and velocity `velocity`: v' = a - w_c v and each filter pair's.
+    pub fn continuous_rates(&self, accel: f64, velocity: f64) -> [f64; TRACKER_CONTINUOUS] {
+        let v = if self.measured_v_seen {
+            velocity
+        } else {
+            self.rebuilt_v
+        };
+        let (first, second) = self.squares.rates(self.tau, [v * v, accel * accel]);
+        let ([w1], [w2]) = self.weight.rates(self.tau, [1.0]);
+        [
+            accel - self.leak * self.rebuilt_v,
+            first[V],
+            second[V],
+            first[A],
+            second[A],
+            w1,
+            w2,
+        ]
     }
 
     /// The evolving part of the estimator, for saving the state.

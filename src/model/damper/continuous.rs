@@ -13,21 +13,14 @@ use crate::model::{AmplitudeSource, Inputs, Output};
 pub enum Unknown {
     Derivative(usize),
     Output(Output),
+    /// The derivative of a state this model does not have (identically 0).
+    Frozen,
 }
 
 impl Damper {
     /// Ok if a host's solver can integrate this damper; Err: why not.
     pub fn offers_model_exchange(&self) -> Result<(), String> {
-        self.model.offers_model_exchange()?;
-        if let AmplitudeSource::Tracked { .. } = self.common.amplitude {
-            return Err(
-                "amplitude = Tracked estimates A_e by a filter sampled at the communication \
-                 steps, which Model Exchange does not have: set amplitude = Fixed (the damping \
-                 law then uses A_e), or use Co-Simulation"
-                    .into(),
-            );
-        }
-        Ok(())
+        self.model.offers_model_exchange()
     }
 
     /// The continuous states [slosh.x, slosh.v, energy.input, energy.dissipated, impact.z,
@@ -91,6 +84,14 @@ impl Damper {
         out: &mut [f64],
     ) -> Result<(), String> {
         self.offers_model_exchange()?;
+        if let AmplitudeSource::Tracked { .. } = self.common.amplitude {
+            return Err(
+                "amplitude = Tracked has no directional derivatives (the damping ratio's \
+                 dependence on the estimator's states is not differentiated); difference \
+                 fmi2GetDerivatives, or set amplitude = Fixed"
+                    .into(),
+            );
+        }
         let t = self.model.continuous_tangent(inputs.a, d)?;
         let mut values = Vec::with_capacity(unknowns.len());
         for &unknown in unknowns {
@@ -99,6 +100,7 @@ impl Damper {
                     format!("there are {STATES} state derivatives, not {}", k + 1)
                 })?,
                 Unknown::Output(which) => self.output_tangent(which, d, &t)?,
+                Unknown::Frozen => 0.0,
             });
         }
         out.copy_from_slice(&values);

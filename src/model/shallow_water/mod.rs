@@ -248,16 +248,12 @@ impl Model for ShallowWater {
     fn rate(&self, which: Output, a: f64, _a_rate: f64) -> f64 {
         let ch = &self.channel;
         let (h, q) = (&self.flow.depth, &self.flow.discharge);
-        let r = ch.rates(&self.flow, a);
         let c = self.drag();
+        let r = ch.semi_discrete(&self.flow, a, c);
         let dx = ch.dx();
         let n = ch.cells;
         let dry = DRY * ch.depth;
-        let mut r = r;
-        if !ch.screens.is_empty() {
-            ch.screens.add_rates(h, q, &mut r.discharge, dry);
-        }
-        let dq = |i: usize| r.discharge[i] - c * q[i];
+        let dq = |i: usize| r.discharge[i];
         let momentum_rate = (0..n).map(dq).sum::<f64>() * dx;
         // Wall depths 1.5 H_0 - 0.5 H_1 (cut at 0) and their rates.
         let [left, right] = ch.wall_depths(&self.flow);
@@ -285,8 +281,8 @@ impl Model for ShallowWater {
                 if ch.screens.is_empty() {
                     self.scale * force
                 } else {
-                    let dq: Vec<f64> = (0..n).map(dq).collect();
-                    self.scale * (force + ch.screens.drag_rate(h, q, &r.depth, &dq, dry) * dx)
+                    let drag = ch.screens.drag_rate(h, q, &r.depth, &r.discharge, dry);
+                    self.scale * (force + drag * dx)
                 }
             }
             Output::X => {
@@ -348,5 +344,6 @@ impl Model for ShallowWater {
     }
 }
 
+pub mod continuous;
 #[cfg(test)]
 mod tests;

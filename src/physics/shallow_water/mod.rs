@@ -237,6 +237,24 @@ impl Channel {
         out
     }
 
+    /// The semi-discrete equations' right-hand side at `f`, under base acceleration `a` and
+    /// drag coefficient `c` [1/s]: [`Channel::rates`] with the drag -c q and the screens'
+    /// losses added to the discharge rates (what the substeps split off and integrate exactly).
+    /// The ODE a host's solver integrates in Model Exchange, and along which the outputs'
+    /// rates are taken.
+    pub fn semi_discrete(&self, f: &Flow, a: f64, c: f64) -> Rates {
+        let mut r = self.rates(f, a);
+        if !self.screens.is_empty() {
+            let dry = DRY * self.depth;
+            self.screens
+                .add_rates(&f.depth, &f.discharge, &mut r.discharge, dry);
+        }
+        for (dq, q) in r.discharge.iter_mut().zip(&f.discharge) {
+            *dq -= c * q;
+        }
+        r
+    }
+
     /// Advance `f` by `h` under base acceleration `base` and drag coefficient `c` [1/s], in at
     /// most `most` substeps. On error `f` is left part-way: callers step a copy.
     pub fn advance(
