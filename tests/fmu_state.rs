@@ -130,22 +130,25 @@ fn bad_serialized_states_are_refused() {
     assert_eq!(inst.run_harmonic(50, 0.01).to_bits(), reference.to_bits());
 }
 
+/// An initialised instance of the shallow-water model with 30 cells.
+fn shallow_water(name: &str) -> Instance {
+    let inst = Instance::new(name);
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(
+        inst.set_integer(vr::MODEL, ModelKindItem::ShallowWater.value() as i32),
+        OK
+    );
+    assert_eq!(inst.set_integer(vr::SWE_CELLS, 30), OK);
+    assert_eq!(inst.exit(), OK);
+    inst
+}
+
 /// The shallow-water model's state (every cell's depth and discharge, the work done) survives
 /// a serialised round trip into another instance, and both continue bit for bit.
 #[test]
 fn shallow_water_state_round_trip() {
-    let start = |name: &str| {
-        let inst = Instance::new(name);
-        assert_eq!(inst.setup(), OK);
-        assert_eq!(inst.enter(), OK);
-        assert_eq!(
-            inst.set_integer(vr::MODEL, ModelKindItem::ShallowWater.value() as i32),
-            OK
-        );
-        assert_eq!(inst.set_integer(vr::SWE_CELLS, 30), OK);
-        assert_eq!(inst.exit(), OK);
-        inst
-    };
+    let start = shallow_water;
     let mut a = start("swe-source");
     a.run_harmonic(200, 0.01);
     let s = get_state(&a);
@@ -171,15 +174,7 @@ fn shallow_water_state_round_trip() {
 /// derivatives (found by the coverage-guided fuzzer: fuzz/, deserialize_tld).
 #[test]
 fn a_state_whose_outputs_would_not_be_finite_is_refused() {
-    let inst = Instance::new("state-absurd");
-    assert_eq!(inst.setup(), OK);
-    assert_eq!(inst.enter(), OK);
-    assert_eq!(
-        inst.set_integer(vr::MODEL, ModelKindItem::ShallowWater.value() as i32),
-        OK
-    );
-    assert_eq!(inst.set_integer(vr::SWE_CELLS, 30), OK);
-    assert_eq!(inst.exit(), OK);
+    let inst = shallow_water("state-absurd");
     let s = get_state(&inst);
     let bytes = serialize(&inst, s);
     // The frame (fmi2_slave::frame) and TLD's part (src/fmi/snapshot.rs): header, then the

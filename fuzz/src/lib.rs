@@ -4,8 +4,10 @@
 //! records every message, and checks the invariants after every call:
 //!
 //! - every status is a valid fmi2Status a call may return (OK, Warning, Discard, Error: never
-//!   Fatal or Pending), and no call panics (a panic the FMI layer caught is logged as an
-//!   "internal error", which fails the target as a crash would);
+//!   Fatal or Pending), and nothing panics, not even a panic the FMI layer would catch and
+//!   turn into a logged "internal error": libfuzzer-sys's panic hook aborts the process on any
+//!   panic, caught or not. (Not by looking for the message: libFuzzer learns the strings the
+//!   harness compares with and puts them into a state's GUID, which the FMU's refusal quotes.)
 //! - a refused call (fmi2Error, fmi2Discard) on an instance logs why and leaves the instance
 //!   exactly as it was (its serialised state, which holds every variable, the phase, the time
 //!   and the simulation, byte for byte);
@@ -53,29 +55,6 @@ impl log::Log for Capture {
 /// How many messages the FMU has logged so far (in this input).
 pub fn logged() -> usize {
     RECORDS.lock().map(|r| r.len()).unwrap_or(0)
-}
-
-/// The messages from the `from`-th on.
-pub fn messages_since(from: usize) -> Vec<String> {
-    RECORDS
-        .lock()
-        .map(|r| {
-            r[from.min(r.len())..]
-                .iter()
-                .map(|(_, m)| m.clone())
-                .collect()
-        })
-        .unwrap_or_default()
-}
-
-/// A message of the FMI layer's panic handler: a bug found.
-fn assert_no_internal_error(from: usize, what: &dyn std::fmt::Debug) {
-    for m in messages_since(from) {
-        assert!(
-            !m.contains("internal error"),
-            "{what:?} panicked inside the FMU: {m}"
-        );
-    }
 }
 
 /// Statuses a call may return to a host.
@@ -257,7 +236,6 @@ pub fn deserialize<S: Slave>(data: &[u8]) {
     let (made, set) = host.load(&bytes);
     let what = format!("loading {} bytes (made {made}, set {set:?})", bytes.len());
     assert_valid_status(made, &what);
-    assert_no_internal_error(from, &what);
     match set {
         Some(OK) => {}
         Some(status) => {

@@ -9,8 +9,8 @@ use std::path::Path;
 use building_model::description::vr as bvr;
 use fmi2_slave::Slave;
 use tld_fmu::fmi::vars::{ModelKindItem, vr};
-use tld_fuzz::Host;
 use tld_fuzz::calls::{Call, Int, Len, Real, Run, Step, Vr};
+use tld_fuzz::{Host, OK};
 
 /// The states of `S` with each of `parameters` (value references and Integer values) set.
 fn states<S: Slave>(parameters: &[Vec<(u32, i32)>]) -> Vec<Vec<u8>> {
@@ -49,9 +49,13 @@ fn states<S: Slave>(parameters: &[Vec<(u32, i32)>]) -> Vec<Vec<u8>> {
                             });
                         }
                     }
+                    let state = run.host.serialised();
+                    // Every state an instance saves loads into a new instance of its kind.
+                    let mut fresh = Host::<S>::new(model_exchange, false);
+                    assert_eq!(fresh.load(&state), (OK, Some(OK)), "{set:?} depth {depth}");
                     let flags = u8::from(model_exchange) | depth << 1 | 16;
                     let mut bytes = vec![flags];
-                    bytes.extend(run.host.serialised());
+                    bytes.extend(state);
                     out.push(bytes);
                 }
             }
