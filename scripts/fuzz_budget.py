@@ -50,7 +50,7 @@ class Target:
 
     def start(self):
         self.runs += 1
-        self.log.write(f"== run {self.runs}, {self.budget - self.used:.0f} CPU s left\n")
+        self.log.write(f"\n== run {self.runs}, {self.budget - self.used:.0f} CPU s left\n")
         self.log.flush()
         args = [self.binary, "-print_final_stats=1", "-timeout=10",
                 f"-artifact_prefix={self.artifacts}/"]
@@ -87,7 +87,11 @@ class Target:
 
     def summarise(self):
         text = open(self.log_path, errors="replace").read()
-        self.execs = sum(int(x) for x in re.findall(r"stat::number_of_executed_units: (\d+)", text))
+        # Per run: libFuzzer's final count, or (a run killed without one) its last status line.
+        for run in text.split("\n== run ")[1:]:
+            final = re.findall(r"stat::number_of_executed_units: (\d+)", run)
+            status = re.findall(r"^#(\d+)", run, re.M)
+            self.execs += int((final or status or ["0"])[-1])
         last = re.findall(r"cov: (\d+) ft: (\d+) corp: (\d+)", text)
         if last:
             self.cov, self.ft, self.corp = (int(x) for x in last[-1])
@@ -117,10 +121,10 @@ def main():
         t.summarise()
         total_cpu += t.used
         total_execs += t.execs
-        rows.append(f"{t.name:22} {t.used:8.0f} {t.runs:5} {t.execs:10} {t.execs / max(t.used, 1e-9):8.0f}"
+        rows.append(f"{t.name:22} {t.used:8.0f} {t.runs:5} {t.execs:10} {t.execs / max(t.used, 1e-9):10.0f}"
                     f" {t.cov or 0:6} {t.ft or 0:6} {t.corp:6}  {len(t.findings)}"
                     + "".join(f"\n    finding: {t.artifacts}/{f}" for f in t.findings))
-    print(f"{'target':22} {'CPU s':>8} {'runs':>5} {'execs':>10} {'exec/s':>8} {'cov':>6} {'ft':>6} {'corpus':>6}  findings")
+    print(f"{'target':22} {'CPU s':>8} {'runs':>5} {'execs':>10} {'exec/CPUs':>10} {'cov':>6} {'ft':>6} {'corpus':>6}  findings")
     print("\n".join(rows))
     print(f"total: {total_cpu:.0f} CPU s ({total_cpu / 3600:.2f} CPU-hours), {total_execs} execs,"
           f" {wall:.0f} s wall; logs in {work}/logs/")
