@@ -105,10 +105,7 @@ fn bad_serialized_states_are_refused() {
     // A well-formed buffer of another format version (checksum recomputed).
     let mut other = bytes[..bytes.len() - 8].to_vec();
     other[4] = 2;
-    let sum = other.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    });
-    other.extend_from_slice(&sum.to_le_bytes());
+    other.extend_from_slice(&fmi2_slave::frame::fnv1a(&other).to_le_bytes());
     assert_eq!(deserialize(&inst, &other).0, ERROR, "version 2");
     let logs = inst.logs();
     assert!(logs.iter().any(|m| m.contains("truncated")), "{logs:?}");
@@ -133,22 +130,25 @@ fn bad_serialized_states_are_refused() {
     assert_eq!(inst.run_harmonic(50, 0.01).to_bits(), reference.to_bits());
 }
 
+/// An initialised instance of the shallow-water model with 30 cells.
+fn shallow_water(name: &str) -> Instance {
+    let inst = Instance::new(name);
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(
+        inst.set_integer(vr::MODEL, ModelKindItem::ShallowWater.value() as i32),
+        OK
+    );
+    assert_eq!(inst.set_integer(vr::SWE_CELLS, 30), OK);
+    assert_eq!(inst.exit(), OK);
+    inst
+}
+
 /// The shallow-water model's state (every cell's depth and discharge, the work done) survives
 /// a serialised round trip into another instance, and both continue bit for bit.
 #[test]
 fn shallow_water_state_round_trip() {
-    let start = |name: &str| {
-        let inst = Instance::new(name);
-        assert_eq!(inst.setup(), OK);
-        assert_eq!(inst.enter(), OK);
-        assert_eq!(
-            inst.set_integer(vr::MODEL, ModelKindItem::ShallowWater.value() as i32),
-            OK
-        );
-        assert_eq!(inst.set_integer(vr::SWE_CELLS, 30), OK);
-        assert_eq!(inst.exit(), OK);
-        inst
-    };
+    let start = shallow_water;
     let mut a = start("swe-source");
     a.run_harmonic(200, 0.01);
     let s = get_state(&a);
@@ -165,6 +165,48 @@ fn shallow_water_state_round_trip() {
     unsafe {
         a.lib.fmi2FreeFMUstate(a.c, &mut s);
         b.lib.fmi2FreeFMUstate(b.c, &mut r);
+    }
+}
+
+/// A shallow-water state whose discharges are finite but absurd (1e290 m^2/s), its checksum
+/// recomputed, is refused by fmi2DeSerializeFMUstate with the variable it would make
+/// non-finite: before, it was accepted and fmi2GetReal then handed out force = -inf and NaN
+/// derivatives (found by the coverage-guided fuzzer: fuzz/, deserialize_tld).
+#[test]
+fn a_state_whose_outputs_would_not_be_finite_is_refused() {
+    let inst = shallow_water("state-absurd");
+    let s = get_state(&inst);
+    let bytes = serialize(&inst, s);
+    // The frame (fmi2_slave::frame) and TLD's part (src/fmi/snapshot.rs): header, then the
+    // payload's phase, flags, four times, two input derivatives, the values, the simulation
+    // (the model's state first: 30 depths, then 30 discharges).
+    let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    let payload = 10 + usize::from(u16::from_le_bytes([bytes[8], bytes[9]])) + 4;
+    let values = payload + 2 + 4 * 8 + 2 * 8;
+    let simulation = values + 4 + 8 * u32_at(values);
+    assert!(u32_at(simulation) > 60);
+    let mut absurd = bytes[..bytes.len() - 8].to_vec();
+    for cell in 30..60 {
+        let at = simulation + 4 + 8 * cell;
+        absurd[at..at + 8].copy_from_slice(&1e290f64.to_le_bytes());
+    }
+    absurd.extend_from_slice(&fmi2_slave::frame::fnv1a(&absurd).to_le_bytes());
+    let (status, mut made) = deserialize(&inst, &absurd);
+    assert_eq!(status, ERROR);
+    assert!(made.is_null());
+    let logs = inst.logs();
+    assert!(
+        logs.last().is_some_and(|m| m.contains("its values give")),
+        "{logs:?}"
+    );
+    // The same bytes with the discharges left as they were load.
+    let (status, mut good) = deserialize(&inst, &bytes);
+    assert_eq!(status, OK);
+    let mut s = s;
+    unsafe {
+        inst.lib.fmi2FreeFMUstate(inst.c, &mut s);
+        inst.lib.fmi2FreeFMUstate(inst.c, &mut good);
+        inst.lib.fmi2FreeFMUstate(inst.c, &mut made);
     }
 }
 

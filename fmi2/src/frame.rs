@@ -31,7 +31,9 @@ pub struct Common {
     pub flag: bool,
 }
 
-fn fnv1a(bytes: &[u8]) -> u64 {
+/// The frame's checksum (FNV-1a 64) of `bytes`: public so that a fuzzer can make a mutated
+/// state pass the check and reach the parser behind it (fuzz/).
+pub fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
         (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
     })
