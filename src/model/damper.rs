@@ -361,4 +361,6 @@ mod events;
 pub use continuous::Unknown;
 
 #[cfg(test)]
+mod me_tests;
+#[cfg(test)]
 mod tests;
