@@ -92,7 +92,7 @@ fn the_dampers_states_nominals_and_rates_are_eq_2_1s() {
         close(n[k], want, 1e-12, &format!("nominal {k}"));
     }
     for (k, got) in n.iter().enumerate().skip(BANK) {
-        let want = if (k - BANK) % 2 == 0 { x } else { v };
+        let want = if (k - BANK).is_multiple_of(2) { x } else { v };
         close(*got, want, 1e-12, &format!("nominal {k}"));
     }
     let mut s = [0.0; STATES];
