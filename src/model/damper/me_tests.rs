@@ -7,6 +7,7 @@
 use super::*;
 use crate::model::continuous::{BANK, Direction, IMPACT_V, IMPACT_Z, STATES};
 use crate::model::slamming::Event;
+use crate::model::wiring_tests::OUTPUTS;
 use crate::model::{StartValues, Unknown};
 
 const LINEAR: f64 = 1.0;
@@ -193,23 +194,6 @@ fn a_tracked_amplitude_is_not_offered() {
     assert_eq!(got, Err(why));
     assert_eq!(out, [7.0]);
 }
-
-const OUTPUTS: [Output; 14] = [
-    Output::Force,
-    Output::X,
-    Output::V,
-    Output::ForceMean,
-    Output::BaseShear,
-    Output::EnergyInput,
-    Output::EnergyDissipated,
-    Output::EnergyStored,
-    Output::Amplitude,
-    Output::Zeta,
-    Output::ImpactZ,
-    Output::Impacts,
-    Output::SurfaceLeft,
-    Output::SurfaceRight,
-];
 
 /// J d of every output and every derivative against central differences of the outputs and
 /// derivatives themselves (each at most quadratic in the states and the input, so the central
