@@ -363,4 +363,6 @@ mod tracked;
 pub use continuous::Unknown;
 
 #[cfg(test)]
+mod me_tests;
+#[cfg(test)]
 mod tests;

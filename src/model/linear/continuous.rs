@@ -165,6 +165,36 @@ mod tests {
         }
     }
 
+    /// The energy states are the totals over the modes: with the higher modes carrying shares of
+    /// their own (as after Co-Simulation steps, or restored), the totals set are the totals
+    /// read back and observed, the higher modes' shares kept, the rest the fundamental's.
+    #[test]
+    fn the_energy_states_are_totals_whatever_the_higher_modes_carry() {
+        let mut m = linear(3.0);
+        let AnyModel::Linear(l) = &mut m else {
+            panic!("Linear")
+        };
+        let shares = [(0.2, 0.05), (-0.1, 0.3)];
+        for (mode, (w, d)) in l.modes.iter_mut().skip(1).zip(shares) {
+            mode.state.work_in = w;
+            mode.state.dissipated = d;
+        }
+        let mut s = state(3);
+        (s[2], s[3]) = (0.75, 0.125);
+        m.set_continuous_states(&s, 0.25).expect("takes them");
+        let back = m.continuous_states(0.25);
+        assert!((back[2] - 0.75).abs() < 1e-15, "{}", back[2]);
+        assert!((back[3] - 0.125).abs() < 1e-15, "{}", back[3]);
+        assert!((m.observe(Observable::WorkIn) - 0.5).abs() < 1e-15);
+        assert!((m.observe(Observable::Dissipated) - 0.125).abs() < 1e-15);
+        let AnyModel::Linear(l) = &m else {
+            panic!("Linear")
+        };
+        for (mode, (w, d)) in l.modes.iter().skip(1).zip(shares) {
+            assert_eq!((mode.state.work_in, mode.state.dissipated), (w, d));
+        }
+    }
+
     /// J d of every state and the base acceleration, for the derivatives, the force and the
     /// stored energy, against central differences (exact but for rounding: linear system).
     #[test]

@@ -193,3 +193,85 @@ fn the_tangent_is_the_derivatives_change() {
         let _ = IMPACT_V;
     }
 }
+
+/// At a wall, only a mass moving into it, or at speed 0 pressed onto it by the base, hits it:
+/// at speed 0 with the base pulling it away it leaves, and moving away it leaves even while
+/// the base presses it back (the rebound of the last impact): no event, nothing changed.
+#[test]
+fn at_a_wall_only_a_mass_moving_into_it_or_pressed_at_rest_hits_it() {
+    let mut m = s2(0.8);
+    let s = slam(&mut m);
+    // (z, v, a): at +d/2 the base presses the mass there when a <= 0 (relative acceleration
+    // -a), at -d/2 when a >= 0.
+    for (z, v, a) in [
+        (0.5 * D, 0.0, 0.5),
+        (-0.5 * D, 0.0, -0.5),
+        (0.5 * D, -0.2, -2.0),
+        (-0.5 * D, 0.2, 2.0),
+        (0.5 * D, -0.2, 0.0),
+    ] {
+        s.state.z = z;
+        s.state.v = v;
+        let before = s.state;
+        assert_eq!(s.event(a), Event::None, "z {z}, v {v}, a {a}");
+        assert_eq!(s.state, before, "z {z}, v {v}, a {a}");
+    }
+    // Pressed at speed 0 (a = 0 counts as pressing): it rests.
+    for (z, a) in [(0.5 * D, 0.0), (-0.5 * D, 0.0), (0.5 * D, -1.0)] {
+        s.state.z = z;
+        s.state.v = 0.0;
+        s.state.contact = 0;
+        assert!(
+            matches!(s.event(a), Event::Impact { rests: true, .. }),
+            "z {z}, a {a}"
+        );
+        s.state.contact = 0;
+    }
+}
+
+/// The contact functions of a fast flight (speeds above 1 m/s, as in a large tank): the gap
+/// to the wall it moves towards, the gap plus d to the other.
+#[test]
+fn fast_flights_have_the_gap_towards_the_wall_they_move_to() {
+    let mut m = s2(0.8);
+    let s = slam(&mut m);
+    s.state.z = 0.01;
+    for v in [-1.5, -40.0, 1.5, 40.0] {
+        s.state.v = v;
+        let want = if v > 0.0 {
+            [0.5 * D - 0.01, 0.5 * D + 0.01 + D]
+        } else {
+            [0.5 * D - 0.01 + D, 0.5 * D + 0.01]
+        };
+        let got = s.contact_functions(0.3);
+        for k in 0..2 {
+            assert!(
+                (got[k] - want[k]).abs() < 1e-15,
+                "v {v}: {got:?} vs {want:?}"
+            );
+        }
+    }
+}
+
+/// At rest on a wall a host's trial state may carry a velocity; the stored energy reads it
+/// (m v^2/2), and so does its tangent, while the rates stay 0.
+#[test]
+fn at_rest_the_stored_energys_tangent_reads_the_velocity() {
+    let mut m = s2(0.8);
+    let s = slam(&mut m);
+    s.state.z = 0.5 * D;
+    s.state.contact = 1;
+    s.state.v = 0.2;
+    let mass = s.impact_mass;
+    let t = s.impact_tangent(-1.0, 0.5, 0.3);
+    assert!((t.kinetic - mass * 0.2 * 0.5).abs() < 1e-15 * mass, "{t:?}");
+    assert_eq!((t.z_rate, t.v_rate, t.power), (0.0, 0.0, 0.0));
+    let stored = |v: f64, m: &mut AnyModel| {
+        slam(m).state.v = v;
+        m.observe(crate::model::Observable::Stored)
+    };
+    let h = 1e-4;
+    // d(stored)/dv times the direction's 0.5.
+    let fd = 0.5 * (stored(0.2 + h, &mut m) - stored(0.2 - h, &mut m)) / (2.0 * h);
+    assert!((fd - mass * 0.2 * 0.5).abs() < 1e-9 * mass, "{fd}");
+}
