@@ -10,7 +10,7 @@ use tld_fmu::fmi::vars::vr;
 
 /// Continuous states of TLD.fmu in ME: slosh.x, slosh.v, energy.input, energy.dissipated,
 /// impact.z, impact.v, the Linear model's mode[n].x, mode[n].v (n = 2..10), the amplitude
-/// estimator's 7 and the ShallowWater cell bank (frozen at 0 where unused).
+/// estimator's 7 (frozen at 0 where unused).
 const N: usize = tld_fmu::model::continuous::ALL_STATES;
 /// Items: model = Linear (1), Nonlinear (2), SloshingSlamming (3); damping Constant (1);
 /// amplitude Fixed (1).
@@ -146,7 +146,7 @@ fn calls_out_of_order_say_what_to_call_first() {
         "fmi2DoStep is not allowed in state EventMode",
         "fmi2CoSimulation",
         "Call fmi2EnterEventMode first",
-        "the model description declares 431",
+        "the model description declares 31",
         "state 1 is NaN",
         "ran away",
     ] {
@@ -282,7 +282,7 @@ fn instantiating_for_model_exchange_says_what_is_offered() {
     for part in [
         "Linear (modes <= 10)",
         "SloshingSlamming (impacts as state events)",
-        "ShallowWater (swe.cells <= 200)",
+        "ShallowWater (2 x swe.cells states) are Co-Simulation only",
         "amplitude = Fixed or Tracked",
     ] {
         assert!(said.contains(part), "no '{part}' in: {said}");

@@ -215,12 +215,11 @@ impl Continuous for Tld {
     const EVENT_INDICATORS: usize = EVENT_INDICATORS;
     const MODEL_EXCHANGE_NOTE: Option<&'static str> = Some(
         "Model Exchange offers model = Linear (modes <= 10), Nonlinear, Auto, \
-         SloshingSlamming (impacts as state events) and ShallowWater (swe.cells <= 200) with \
-         amplitude = Fixed or Tracked; the states are slosh.x, slosh.v, energy.input, \
-         energy.dissipated, impact.z, impact.v, mode[n].x, mode[n].v (n = 2..10, Linear's \
-         higher modes), the amplitude estimator's A_e.tracker.*, then the ShallowWater cells \
-         swe.h[i], swe.q[i] (each frozen at 0 where the configuration has none). Linear with \
-         more modes and ShallowWater with more cells are Co-Simulation only \
+         and SloshingSlamming (impacts as state events) with amplitude = Fixed or Tracked; the \
+         states are slosh.x, slosh.v, energy.input, energy.dissipated, impact.z, impact.v, \
+         mode[n].x, mode[n].v (n = 2..10, Linear's higher modes), then the amplitude \
+         estimator's A_e.tracker.* (each frozen at 0 where the configuration has none). \
+         Linear with more modes and ShallowWater (2 x swe.cells states) are Co-Simulation only \
          (fmi2ExitInitializationMode says why); see \
          docs/MODEL_EXCHANGE.md",
     );

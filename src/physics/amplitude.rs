@@ -207,14 +207,19 @@ impl AmplitudeTracker {
         std::array::from_fn(|k| s[if k == 0 { 0 } else { k + 1 }])
     }
 
-    /// Take the continuous part (as [`AmplitudeTracker::continuous_state`] gives it); the
-    /// velocity source stays. Err (nothing taken) for a negative mean square or weight, which
-    /// the ODEs never reach (a step far longer than tau does).
+    /// Take the continuous part (as [`AmplitudeTracker::continuous_state`] gives it) from a
+    /// host's solver; the velocity source stays. Any finite values are taken: the filters start
+    /// at 0, and a solver's trial state may put a mean square or weight slightly below 0, which
+    /// [`AmplitudeTracker::estimate`] reads as 0. Err (nothing taken) for a non-finite value.
     pub fn set_continuous_state(&mut self, s: &[f64; TRACKER_CONTINUOUS]) -> Result<(), String> {
+        if s.iter().any(|v| !v.is_finite()) {
+            return Err("amplitude estimator state not finite".into());
+        }
         let mut saved = self.state();
         saved[0] = s[0];
         saved[2..].copy_from_slice(&s[1..]);
-        self.set_state(&saved)
+        self.take_state(&saved);
+        Ok(())
     }
 
     /// The time derivatives of [`AmplitudeTracker::continuous_state`] under the base
@@ -260,6 +265,12 @@ impl AmplitudeTracker {
         {
             return Err("amplitude estimator state out of range".into());
         }
+        self.take_state(s);
+        Ok(())
+    }
+
+    /// Take a saved state as it is (checked by the caller).
+    fn take_state(&mut self, s: &[f64; TRACKER_STATE]) {
         self.rebuilt_v = s[0];
         self.measured_v_seen = s[1] == 1.0;
         self.squares = MeanSquare {
@@ -270,16 +281,19 @@ impl AmplitudeTracker {
             first: [s[6]],
             second: [s[7]],
         };
-        Ok(())
     }
 
-    /// The current amplitude estimate [m].
+    /// The current amplitude estimate [m]: a mean square or weight below 0 (a host solver's
+    /// trial state) counts as 0, so any finite state gives a finite estimate.
     pub fn estimate(&self) -> f64 {
-        let w = self.weight.second[0];
+        let w = self.weight.second[0].max(0.0);
         if w <= 0.0 {
             return self.prior;
         }
-        let (v2, a2) = (self.squares.second[V] / w, self.squares.second[A] / w);
+        let (v2, a2) = (
+            self.squares.second[V].max(0.0) / w,
+            self.squares.second[A].max(0.0) / w,
+        );
         if !(a2 > 0.0 && v2 > 0.0) {
             return self.prior;
         }

@@ -37,11 +37,9 @@ impl Damper {
         let estimator = match &self.tracker {
             Some(t) => {
                 let mut t = t.clone();
-                t.set_continuous_state(tracker).map_err(|why| {
-                    StatesRefused::Step(format!(
-                        "{why} (a mean square below 0: the host's step was too long)"
-                    ))
-                })?;
+                // Any finite trial state is taken (a mean square slightly below 0 included).
+                t.set_continuous_state(tracker)
+                    .map_err(StatesRefused::Invalid)?;
                 Some(t)
             }
             None => None,

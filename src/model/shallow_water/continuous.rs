@@ -12,10 +12,11 @@
 
 use super::ShallowWater;
 
-/// Cells of the Model Exchange bank: the default swe.cells (150) and room for a refinement
-/// study above it, with the model description about 0.4 MB (scripts/me-cells-xml writes its
-/// 4 x 200 variables; the two numbers must agree, which the tests check).
-pub const ME_CELLS: usize = 200;
+/// Cells of the Model Exchange bank: none in the shipped archive, so ShallowWater is refused in
+/// Model Exchange (a bank is integrated by every other model's host too: docs/MODEL_EXCHANGE.md).
+/// A bank of 200 was built and verified; scripts/me-cells-xml writes the description's 4 x N
+/// variables for N cells, and the two numbers must agree, which the tests check.
+pub const ME_CELLS: usize = 0;
 
 /// Continuous states of the bank: depths, then discharges.
 pub const CELL_STATES: usize = 2 * ME_CELLS;
@@ -35,9 +36,11 @@ impl ShallowWater {
         let n = self.channel.cells;
         if n > ME_CELLS {
             return Err(format!(
-                "model = ShallowWater with swe.cells = {n}: Model Exchange declares a bank of \
-                 {ME_CELLS} cells (FMI 2.0 fixes the number of states in the model \
-                 description); use swe.cells <= {ME_CELLS}, or Co-Simulation for more cells"
+                "model = ShallowWater (swe.cells = {n}) is not offered in Model Exchange: its \
+                 2 x swe.cells states cannot be declared, FMI 2.0 fixes the number of states \
+                 in the model description while swe.cells is a parameter, and a declared bank \
+                 of cells would be integrated by every other model's host too \
+                 (docs/MODEL_EXCHANGE.md); use Co-Simulation"
             ));
         }
         Ok(())
