@@ -101,6 +101,9 @@ class Target:
 
 
 def main():
+    if any(a in ("-h", "--help") for a in sys.argv[1:]) or len(sys.argv) < 5:
+        print(__doc__.strip())
+        sys.exit(0 if len(sys.argv) > 1 and sys.argv[1] in ("-h", "--help") else 2)
     bin_dir, work, seconds, *names = sys.argv[1:]
     targets = [Target(n, bin_dir, work, float(seconds)) for n in names]
     wall = time.time()

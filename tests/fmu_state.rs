@@ -210,6 +210,36 @@ fn a_state_whose_outputs_would_not_be_finite_is_refused() {
     }
 }
 
+/// A state of a model Model Exchange does not offer (ShallowWater) does not restore into a Model
+/// Exchange instance, whatever phase it claims: before, a forged one (phase ContinuousTimeMode,
+/// checksum right) was taken and fmi2GetContinuousStates panicked on the missing cell bank,
+/// caught as an internal error (found by the coverage-guided fuzzer: fuzz/, deserialize_tld).
+#[test]
+fn a_state_of_a_model_not_offered_in_model_exchange_is_refused_there() {
+    let inst = shallow_water("swe-cs-state");
+    let s = get_state(&inst);
+    let bytes = serialize(&inst, s);
+    // The payload starts with the phase (fmi2_slave::frame): 3 Terminated, 5 ContinuousTimeMode.
+    let payload = 10 + usize::from(u16::from_le_bytes([bytes[8], bytes[9]])) + 4;
+    let me = Instance::model_exchange("swe-me-target");
+    for phase in [3u8, 5] {
+        let mut forged = bytes[..bytes.len() - 8].to_vec();
+        forged[payload] = phase;
+        forged.extend_from_slice(&fmi2_slave::frame::fnv1a(&forged).to_le_bytes());
+        let (status, made) = deserialize(&me, &forged);
+        assert_eq!(status, ERROR, "phase {phase}");
+        assert!(made.is_null());
+        let logs = me.logs();
+        assert!(
+            logs.last()
+                .is_some_and(|m| m.contains("Model Exchange is not offered")),
+            "{logs:?}"
+        );
+    }
+    let mut s = s;
+    unsafe { inst.lib.fmi2FreeFMUstate(inst.c, &mut s) };
+}
+
 /// The S^2 model's state (impact mass position, velocity, wall contact, count) survives a
 /// serialised round trip into another instance, bit for bit.
 #[test]

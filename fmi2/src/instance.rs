@@ -314,6 +314,17 @@ impl<S: Slave> Instance<S> {
             Kind::ModelExchange if cs_phase => Err(frame::unusable(
                 "it was saved by a Co-Simulation instance; restore it into one made with fmi2CoSimulation",
             )),
+            // Running or terminated, a Model Exchange instance hands out continuous states: its
+            // parameters must be ones Model Exchange offers (a forged or Co-Simulation state of
+            // another model is not; found by the coverage-guided fuzzer).
+            Kind::ModelExchange if me_phase || context.phase == Phase::Terminated => {
+                match slave.offers_model_exchange() {
+                    Ok(()) => Ok((context, slave)),
+                    Err(why) => Err(frame::unusable(&format!(
+                        "Model Exchange is not offered for its parameters: {why}"
+                    ))),
+                }
+            }
             _ => Ok((context, slave)),
         }
     }

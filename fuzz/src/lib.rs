@@ -20,6 +20,7 @@
 //! `deserialize` is the fmi2DeSerializeFMUstate target, `calls` the call-sequence target
 //! (module `calls`: the calls and how bytes decode to them).
 
+pub mod arguments;
 pub mod calls;
 
 use std::ffi::CString;

@@ -111,11 +111,15 @@ def test_model_structure(model_description):
     # Model Exchange: the rest of each output's dependencies are continuous states
     states = {d.variable.derivative.name for d in model_description.derivatives}
     bank = {f"mode[{n}].{q}" for n in range(2, 11) for q in "xv"}
+    tracker = {"A_e.tracker.v"} | {f"A_e.tracker.{q}[{k}]" for q in ("v2", "a2", "weight")
+                                    for k in (1, 2)}
     assert states == {"slosh.x", "slosh.v", "energy.input", "energy.dissipated", "impact.z",
-                      "impact.v"} | bank
+                      "impact.v"} | bank | tracker
     assert all(d - inputs <= states for d in all_deps.values())
-    # The Linear model's force sums its modes.
-    assert all_deps["force"] == {"slosh.x", "slosh.v"} | bank
+    # The Linear model's force sums its modes; with amplitude = Tracked its damping follows the
+    # estimate, formed from the second filters.
+    estimate = {"A_e.tracker.v2[2]", "A_e.tracker.a2[2]", "A_e.tracker.weight[2]"}
+    assert all_deps["force"] == {"slosh.x", "slosh.v"} | bank | estimate
     assert model_description.numberOfEventIndicators == 2
 
 

@@ -3,6 +3,8 @@ use crate::description::{Causality, VARIABLES, VarType};
 use crate::model::StartValues;
 use crate::solver::SolveError;
 
+mod screens;
+
 /// Items of the enumerations (modelDescription.xml) the tests select.
 const LINEAR: f64 = 1.0;
 const NONLINEAR: f64 = 2.0;
@@ -546,92 +548,4 @@ fn unit_mistakes_are_noticed_once() {
     );
     let (_, warnings) = Damper::configure(&defaults()).expect("defaults");
     assert!(warnings.is_empty(), "{warnings:?}");
-}
-
-/// The Screens law reads the amplitude: with amplitude = Tracked its damping follows the
-/// excitation (zeta.effective is the law at A_e.estimate after every step), as NSD's does.
-/// Guards the law's `reads_amplitude` (false held the damping at the prior's for the whole run).
-#[test]
-fn screens_law_follows_a_tracked_amplitude() {
-    let p = tracked(defaults())
-        .with(vr::MODEL, LINEAR)
-        .with(vr::DAMPING, SCREENS)
-        .with(vr::SCREENS_COUNT, 2.0)
-        .with(vr::A_E, 0.0005);
-    let mut sim = damper(&p);
-    let (common, _) = Common::read(&p).expect("parameters");
-    let w = sim.derived().omega_f;
-    let start = sim.output(Output::Zeta, &Inputs::default());
-    for k in 0..3000 {
-        let t = f64::from(k) * 0.01;
-        let inputs = held(-w * w * 0.005 * (w * t).sin());
-        sim.step(t, 0.01, &inputs).expect("step");
-        let (zeta, a_e) = (
-            sim.output(Output::Zeta, &inputs),
-            sim.output(Output::Amplitude, &inputs),
-        );
-        assert_eq!(zeta, common.zeta(a_e), "step {k}");
-    }
-    let end = sim.output(Output::Zeta, &Inputs::default());
-    // The estimate settles near the 5 mm driven, ten times the prior: zeta grows about 3-fold.
-    assert!(end > 2.0 * start, "{start} -> {end}");
-}
-
-/// screens.response: Sinusoidal (the default) is the law as it was, bit for bit; Random takes
-/// A_e as the rms response, zeta_BL + 1.880 K A_e, in every mechanical model, and is refused with
-/// a tracked amplitude (which estimates a harmonic base amplitude) except by ShallowWater,
-/// which resolves the screens and reads no law (the Integer alias: fmi::params' alias test).
-#[test]
-fn screens_response_random_takes_a_e_as_the_rms_response() {
-    use crate::physics::laws::DampingLaw;
-    use crate::physics::screens::{RANDOM_SCREENS, random_zeta, resonant_zeta};
-    let base = defaults()
-        .with(vr::DAMPING, SCREENS)
-        .with(vr::SCREENS_COUNT, 2.0)
-        .with(vr::A_E, 0.002)
-        .with(vr::AMPLITUDE, 1.0);
-    let law = |p: &StartValues| Common::read(p).expect("parameters").0.damping;
-    let DampingLaw::Screens {
-        boundary,
-        per_response,
-        random: false,
-    } = law(&base)
-    else {
-        panic!("the default is Sinusoidal")
-    };
-    let random = base.clone().with(vr::SCREENS_RESPONSE, 2.0);
-    for model in [LINEAR, NONLINEAR, SLAMMING, AUTO] {
-        let sine = damper(&base.clone().with(vr::MODEL, model));
-        let want = resonant_zeta(boundary, per_response, 0.002);
-        assert_eq!(sine.output(Output::Zeta, &Inputs::default()), want);
-        let d = damper(&random.clone().with(vr::MODEL, model));
-        let zeta = d.output(Output::Zeta, &Inputs::default());
-        assert_eq!(zeta, random_zeta(boundary, per_response, 0.002));
-        assert!((zeta - (boundary + RANDOM_SCREENS * per_response * 0.002)).abs() < 1e-15);
-        let err = Damper::configure(
-            &random
-                .clone()
-                .with(vr::MODEL, model)
-                .with(vr::AMPLITUDE, TRACKED),
-        )
-        .expect_err("Random with a tracked amplitude is refused");
-        assert!(err.contains("amplitude = Fixed"), "{err}");
-    }
-    assert!(
-        Damper::configure(
-            &random
-                .clone()
-                .with(vr::MODEL, SHALLOW_WATER)
-                .with(vr::AMPLITUDE, TRACKED)
-        )
-        .is_ok()
-    );
-    // The factor is 1.880 K sigma against the resonant law's root: at this A_e and these screens
-    // the two differ (a test of which one is applied).
-    assert!(
-        (random_zeta(boundary, per_response, 0.002) / resonant_zeta(boundary, per_response, 0.002)
-            - 1.0)
-            .abs()
-            > 0.1
-    );
 }
