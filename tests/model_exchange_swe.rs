@@ -56,3 +56,25 @@ fn the_same_parameters_run_in_co_simulation() {
     assert!(x.is_finite());
     assert!(inst.get_real(vr::SLOSH_X).1.is_finite());
 }
+
+/// A Co-Simulation instance may ask for continuous states and derivatives once terminated (the
+/// call table allows it): for ShallowWater they are refused with the reason, not a panic (found
+/// by the call-sequence fuzzer after the cell bank was taken out).
+#[test]
+fn a_terminated_co_simulation_of_shallow_water_refuses_derivatives() {
+    let inst = Instance::new("swe-cs-terminated");
+    set_up(&inst, SHALLOW_WATER);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
+    assert_eq!(inst.terminate(), OK);
+    let n = tld_fmu::model::continuous::ALL_STATES;
+    assert_ne!(inst.derivatives(n).0, OK);
+    assert_ne!(inst.states(n).0, OK);
+    let said = inst.logs().join("\n");
+    assert!(
+        said.contains("fmi2GetDerivatives: model = ShallowWater")
+            && said.contains("not offered in Model Exchange")
+            && !said.contains("internal error"),
+        "{said}"
+    );
+}

@@ -131,10 +131,17 @@ fn copy_finite(
 }
 
 impl Tld {
+    /// The simulation, for a Model Exchange function: refused before initialisation, and for
+    /// parameters Model Exchange does not offer (a Co-Simulation instance of ShallowWater, which
+    /// the call table lets ask for derivatives once terminated).
     fn running(&self, function: &str) -> Result<&Damper, Refusal> {
-        self.sim
+        let sim = self
+            .sim
             .as_ref()
-            .ok_or_else(|| refuse(format!("{function}: no simulation (not initialised)")))
+            .ok_or_else(|| refuse(format!("{function}: no simulation (not initialised)")))?;
+        sim.offers_model_exchange()
+            .map_err(|why| refuse(format!("{function}: {why}")))?;
+        Ok(sim)
     }
 }
 
@@ -249,6 +256,8 @@ impl Continuous for Tld {
             .sim
             .as_mut()
             .ok_or_else(|| refuse("fmi2SetContinuousStates: no simulation (not initialised)"))?;
+        sim.offers_model_exchange()
+            .map_err(|why| refuse(format!("fmi2SetContinuousStates: {why}")))?;
         sim.set_all_continuous_states(s, tracker, bank)
             .map_err(|why| {
                 let (status, why) = match why {
