@@ -281,3 +281,47 @@ fn slamming_state_round_trip() {
         b.lib.fmi2FreeFMUstate(b.c, &mut r);
     }
 }
+
+/// Nominals are always usable scales: a state whose fixed amplitude is finite but extreme
+/// (forged, checksum right) made the estimator's nominals overflow to inf in
+/// fmi2GetNominalsOfContinuousStates (found by the coverage-guided fuzzer: deserialize_tld);
+/// a nominal that is not finite and positive is now 1.
+#[test]
+fn nominals_stay_finite_for_an_extreme_restored_amplitude() {
+    let inst = Instance::model_exchange("me-extreme-amplitude");
+    assert_eq!(inst.setup(), OK);
+    assert_eq!(inst.enter(), OK);
+    assert_eq!(inst.set_integer(vr::MODEL, 2), OK);
+    assert_eq!(inst.set_integer(vr::AMPLITUDE, 1), OK);
+    assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
+    let s = get_state(&inst);
+    let bytes = serialize(&inst, s);
+    let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    let payload = 10 + usize::from(u16::from_le_bytes([bytes[8], bytes[9]])) + 4;
+    let values = payload + 2 + 4 * 8 + 2 * 8;
+    let simulation = values + 4 + 8 * u32_at(values);
+    // The frame after the model's state: the amplitude first, then 10 more numbers.
+    let amplitude = simulation + 4 + 8 * (u32_at(simulation) - 11);
+    let mut forged = bytes[..bytes.len() - 8].to_vec();
+    forged[amplitude..amplitude + 8].copy_from_slice(&1e200f64.to_le_bytes());
+    forged.extend_from_slice(&fmi2_slave::frame::fnv1a(&forged).to_le_bytes());
+    let (status, mut made) = deserialize(&inst, &forged);
+    assert_eq!(status, OK, "{:?}", inst.logs());
+    assert_eq!(unsafe { inst.lib.fmi2SetFMUstate(inst.c, made) }, OK);
+    assert_eq!(
+        inst.get_real(vr::A_E_ESTIMATE).1,
+        1e200,
+        "not the forged amplitude"
+    );
+    let (status, nominals) = inst.nominals(tld_fmu::model::continuous::ALL_STATES);
+    assert_eq!(status, OK);
+    assert!(
+        nominals.iter().all(|n| n.is_finite() && *n > 0.0),
+        "{nominals:?}"
+    );
+    let mut s = s;
+    unsafe {
+        inst.lib.fmi2FreeFMUstate(inst.c, &mut s);
+        inst.lib.fmi2FreeFMUstate(inst.c, &mut made);
+    }
+}

@@ -327,6 +327,13 @@ impl Continuous for Tld {
         core.copy_from_slice(&sim.continuous_nominals());
         sim.tracker_nominals(tracker);
         sim.cell_nominals(cells);
+        // Nominals are scales, never numbers a host cannot use: one that overflows (the
+        // estimator's squares of an extreme A_e or tank, say) is 1 (the FMI default).
+        for n in out.iter_mut() {
+            if !(n.is_finite() && *n > 0.0) {
+                *n = 1.0;
+            }
+        }
         Ok(Status::Ok)
     }
 
