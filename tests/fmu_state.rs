@@ -131,6 +131,24 @@ fn bad_serialized_states_are_refused() {
 }
 
 /// An initialised instance of the shallow-water model with 30 cells.
+/// Where a serialised TLD state's payload starts (fmi2_slave::frame: tag, version, GUID length
+/// and GUID, payload length): its phase first.
+fn payload_at(bytes: &[u8]) -> usize {
+    10 + usize::from(u16::from_le_bytes([bytes[8], bytes[9]])) + 4
+}
+
+/// The little-endian u32 at `at`, as an index.
+fn u32_at(bytes: &[u8], at: usize) -> usize {
+    u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize
+}
+
+/// Where TLD's simulation list starts (its length, then the model's state and the frame): after
+/// the payload's phase, flags, four times, two input derivatives and the values (src/fmi/snapshot.rs).
+fn simulation_at(bytes: &[u8]) -> usize {
+    let values = payload_at(bytes) + 2 + 4 * 8 + 2 * 8;
+    values + 4 + 8 * u32_at(bytes, values)
+}
+
 fn shallow_water(name: &str) -> Instance {
     let inst = Instance::new(name);
     assert_eq!(inst.setup(), OK);
@@ -180,11 +198,8 @@ fn a_state_whose_outputs_would_not_be_finite_is_refused() {
     // The frame (fmi2_slave::frame) and TLD's part (src/fmi/snapshot.rs): header, then the
     // payload's phase, flags, four times, two input derivatives, the values, the simulation
     // (the model's state first: 30 depths, then 30 discharges).
-    let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
-    let payload = 10 + usize::from(u16::from_le_bytes([bytes[8], bytes[9]])) + 4;
-    let values = payload + 2 + 4 * 8 + 2 * 8;
-    let simulation = values + 4 + 8 * u32_at(values);
-    assert!(u32_at(simulation) > 60);
+    let simulation = simulation_at(&bytes);
+    assert!(u32_at(&bytes, simulation) > 60);
     let mut absurd = bytes[..bytes.len() - 8].to_vec();
     for cell in 30..60 {
         let at = simulation + 4 + 8 * cell;
@@ -220,7 +235,7 @@ fn a_state_of_a_model_not_offered_in_model_exchange_is_refused_there() {
     let s = get_state(&inst);
     let bytes = serialize(&inst, s);
     // The payload starts with the phase (fmi2_slave::frame): 3 Terminated, 5 ContinuousTimeMode.
-    let payload = 10 + usize::from(u16::from_le_bytes([bytes[8], bytes[9]])) + 4;
+    let payload = payload_at(&bytes);
     let me = Instance::model_exchange("swe-me-target");
     for phase in [3u8, 5] {
         let mut forged = bytes[..bytes.len() - 8].to_vec();
@@ -296,12 +311,9 @@ fn nominals_stay_finite_for_an_extreme_restored_amplitude() {
     assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
     let s = get_state(&inst);
     let bytes = serialize(&inst, s);
-    let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
-    let payload = 10 + usize::from(u16::from_le_bytes([bytes[8], bytes[9]])) + 4;
-    let values = payload + 2 + 4 * 8 + 2 * 8;
-    let simulation = values + 4 + 8 * u32_at(values);
+    let simulation = simulation_at(&bytes);
     // The frame after the model's state: the amplitude first, then 10 more numbers.
-    let amplitude = simulation + 4 + 8 * (u32_at(simulation) - 11);
+    let amplitude = simulation + 4 + 8 * (u32_at(&bytes, simulation) - 11);
     let mut forged = bytes[..bytes.len() - 8].to_vec();
     forged[amplitude..amplitude + 8].copy_from_slice(&1e200f64.to_le_bytes());
     forged.extend_from_slice(&fmi2_slave::frame::fnv1a(&forged).to_le_bytes());
