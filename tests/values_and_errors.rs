@@ -455,3 +455,54 @@ fn per_step_calls_are_logged_when_asked_and_refused_as_before() {
     );
     assert!(out.iter().all(|v| v.is_nan()), "{out:?}");
 }
+
+/// A finite input too large for the model's arithmetic (base.v = 1e300, squared in the
+/// amplitude estimator; coverage-guided fuzzing found it in a restored state) never comes out
+/// as an infinite or NaN value, in Co-Simulation or Model Exchange: what a getter hands out
+/// with fmi2OK is finite, and a refusal says why. Before the check, A_e.tracker.v2[1] and its
+/// derivative were handed out as inf with fmi2OK.
+#[test]
+fn an_overflowing_input_never_hands_out_a_non_finite_value() {
+    use tld_fmu::fmi::vars::{VARIABLES, VarType};
+    const N: usize = tld_fmu::model::continuous::ALL_STATES;
+    for me in [false, true] {
+        let mut inst = configured("overflow", me, &[(vr::AMPLITUDE, 2)], &[]);
+        assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
+        assert_eq!(inst.set_real(vr::BASE_A, 0.5), OK);
+        assert_eq!(inst.set_real(vr::BASE_V, 1e300), OK, "a finite input");
+        let mut refused = 0;
+        if me {
+            // The measured base.v switches the estimator (an event), whose rates then read it.
+            assert_eq!(inst.new_discrete_states().0, OK, "{:?}", inst.logs());
+            assert_eq!(inst.enter_continuous_time_mode(), OK);
+            for (s, values) in [inst.derivatives(N), inst.states(N)] {
+                if s == OK {
+                    assert!(values.iter().all(|v| v.is_finite()), "{values:?}");
+                } else {
+                    refused += 1;
+                }
+            }
+        } else {
+            for _ in 0..3 {
+                let _ = inst.do_step(1e-3);
+            }
+        }
+        for v in VARIABLES.iter().filter(|v| v.ty == VarType::Real) {
+            let (s, x) = inst.get_real(v.vr);
+            if s == OK {
+                assert!(x.is_finite(), "{} = {x} handed out (me = {me})", v.name);
+            } else {
+                refused += 1;
+                let logs = inst.logs().join("\n");
+                assert!(logs.contains("too large"), "{}: {logs}", v.name);
+            }
+        }
+        assert!(
+            refused > 0,
+            "me = {me}: the overflow was not met (the test lost its case)"
+        );
+        // The instance stays usable: a sane input, and every variable reads again.
+        assert_eq!(inst.set_real(vr::BASE_V, 0.0), OK);
+        let _ = inst.get_real(vr::FORCE);
+    }
+}

@@ -4,7 +4,7 @@
 
 use fmi_sys::fmi2::*;
 
-use super::{guard, host_ref, host_slice, host_slice_mut};
+use super::{guard, handed_out_finite, host_ref, host_slice, host_slice_mut};
 use crate::calls::{self, Call, Phase};
 use crate::description::finite;
 use crate::slave::Slave;
@@ -68,7 +68,9 @@ unsafe fn fill_array<S: Slave>(
         check_len(call, "the array length", n, declared())?;
         // SAFETY: host output array of n elements.
         let out = unsafe { host_slice_mut(out, n, call, "the output array")? };
-        fill(&inst.slave, &inst.context, out)
+        let status = fill(&inst.slave, &inst.context, out)?;
+        handed_out_finite(call, out, |k| format!("value {k}"))?;
+        Ok(status)
     })
 }
 
@@ -234,7 +236,16 @@ pub unsafe fn fmi2GetDirectionalDerivative<S: Slave>(
                 dv_known[k]
             )));
         }
-        inst.slave
-            .directional_derivative(&inst.context, unknowns, knowns, dv_known, dv_unknown)
+        let status = inst.slave.directional_derivative(
+            &inst.context,
+            unknowns,
+            knowns,
+            dv_known,
+            dv_unknown,
+        )?;
+        handed_out_finite(CALL, dv_unknown, |k| {
+            format!("dvUnknown[{k}] (value reference {})", unknowns[k])
+        })?;
+        Ok(status)
     })
 }

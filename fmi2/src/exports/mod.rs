@@ -25,7 +25,7 @@ use crate::description::log_category;
 use crate::host::{host_ref, host_slice, host_slice_mut, host_text};
 use crate::instance::Instance;
 use crate::slave::Slave;
-use crate::status::{Refusal, Reply, Status};
+use crate::status::{Refusal, Reply, Status, refuse};
 
 /// The one way into an instance: `body` runs on the instance behind `c` if `call` is allowed in
 /// its phase; refusals become logged statuses, and a panic a logged fmi2Error that leaves the
@@ -100,6 +100,28 @@ fn broken<S: Slave>(
         ),
     );
     Status::Error as fmi2Status
+}
+
+/// Nothing leaves the FMU that a host cannot use: `values` a call is about to hand out, all
+/// finite, or refused (fmi2Error, the instance unchanged: only the host's array was written),
+/// naming `what` the k-th value is. Finite inputs and states can still overflow on their way
+/// out (a base.v of 1e300 squared in the amplitude estimator: found by coverage-guided fuzzing,
+/// docs/FUZZING.md); the models' own checks say more where they can.
+fn handed_out_finite(
+    call: &Call,
+    values: &[f64],
+    what: impl Fn(usize) -> String,
+) -> Result<(), Refusal> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(refuse(format!(
+            "{}: {} would be {}: an input or state is too large for the model's arithmetic; \
+             set finite values of a physical size (or reset the instance)",
+            call.name,
+            what(k),
+            values[k]
+        ))),
+    }
 }
 
 #[cfg(test)]

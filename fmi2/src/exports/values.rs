@@ -5,7 +5,7 @@ use fmi_sys::fmi2::*;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-use super::{guard, host_slice, host_slice_mut};
+use super::{guard, handed_out_finite, host_slice, host_slice_mut};
 use crate::calls::{self, Call};
 use crate::description::VarType;
 use crate::host::valid_array;
@@ -19,6 +19,12 @@ trait Access {
     const TYPE: VarType;
     fn to_host(value: f64) -> Self::Host;
     fn from_host(value: Self::Host) -> f64;
+    /// The values handed out, as reals (to be checked finite; Integers and Booleans always
+    /// are).
+    fn reals(values: &[Self::Host]) -> &[f64] {
+        let _ = values;
+        &[]
+    }
 }
 
 struct Reals;
@@ -35,6 +41,9 @@ impl Access for Reals {
     #[inline(always)]
     fn from_host(value: fmi2Real) -> f64 {
         value
+    }
+    fn reals(values: &[fmi2Real]) -> &[f64] {
+        values
     }
 }
 
@@ -105,7 +114,8 @@ unsafe fn get<S: Slave, A: Access>(
         let mut done = true;
         for (slot, &r) in out.iter_mut().zip(vrs) {
             match quietly(r) {
-                Ok(Some(v)) => *slot = A::to_host(v),
+                // A value that is not finite goes the full path, which refuses it.
+                Ok(Some(v)) if v.is_finite() => *slot = A::to_host(v),
                 _ => {
                     done = false;
                     break;
@@ -137,8 +147,13 @@ unsafe fn get_in_full<S: Slave, A: Access>(
                 host_slice_mut(value, nvr, call, "value")?,
             )
         };
-        inst.slave
-            .get(&inst.context, vrs, out, A::TYPE, call.name, A::to_host)
+        let status = inst
+            .slave
+            .get(&inst.context, vrs, out, A::TYPE, call.name, A::to_host)?;
+        handed_out_finite(call, A::reals(out), |k| {
+            format!("the variable with value reference {}", vrs[k])
+        })?;
+        Ok(status)
     })
 }
 
@@ -344,7 +359,15 @@ pub unsafe fn fmi2GetRealOutputDerivatives<S: Slave>(
                 host_slice_mut(value, nvr, CALL, "value")?,
             )
         };
-        inst.slave
-            .output_derivatives(&inst.context, vrs, orders, |k, v| out[k] = v)
+        let status = inst
+            .slave
+            .output_derivatives(&inst.context, vrs, orders, |k, v| out[k] = v)?;
+        handed_out_finite(CALL, out, |k| {
+            format!(
+                "the derivative of order {} of value reference {}",
+                orders[k], vrs[k]
+            )
+        })?;
+        Ok(status)
     })
 }
