@@ -76,6 +76,34 @@ impl DampingLaw {
     }
 }
 
+impl DampingLaw {
+    /// d zeta / d a_e of [`DampingLaw::zeta`] at `a_e`: 0 for the laws that ignore the
+    /// amplitude and where Lambda is clamped (at the clamp's ends, the clamped side's 0).
+    pub fn zeta_slope(&self, a_e: f64, length: f64, range: LambdaRange) -> f64 {
+        match *self {
+            DampingLaw::Constant(_) | DampingLaw::BoundaryLayer(_) => 0.0,
+            DampingLaw::Nsd { c, p } => {
+                let lambda = a_e / length;
+                if range.min < lambda && lambda < range.max {
+                    c * p * lambda.powf(p - 1.0) / length
+                } else {
+                    0.0
+                }
+            }
+            DampingLaw::Screens {
+                boundary,
+                per_response,
+                random: false,
+            } => crate::physics::screens::resonant_zeta_slope(boundary, per_response, a_e),
+            DampingLaw::Screens {
+                per_response,
+                random: true,
+                ..
+            } => crate::physics::screens::random_zeta_slope(per_response, a_e),
+        }
+    }
+}
+
 /// Frequency hardening ratio kappa(Lambda) of the NSD fit (the two branches meet at 0.03).
 pub fn nsd_kappa(lambda: f64) -> f64 {
     if lambda < 0.03 {
