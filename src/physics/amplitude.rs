@@ -346,7 +346,7 @@ impl AmplitudeTracker {
         if w <= 0.0 {
             return self.prior;
         }
-        self.from_means(
+        self.of_means(
             self.squares.second[V].max(0.0) / w,
             self.squares.second[A].max(0.0) / w,
         )
@@ -355,7 +355,7 @@ impl AmplitudeTracker {
 
     /// The estimate from the mean squares `v2` of the velocity and `a2` of the acceleration,
     /// with its partial derivatives by them; None where they give none (the prior stands).
-    fn from_means(&self, v2: f64, a2: f64) -> Option<(f64, [f64; 2])> {
+    fn of_means(&self, v2: f64, a2: f64) -> Option<(f64, [f64; 2])> {
         if !(a2 > 0.0 && v2 > 0.0) {
             return None;
         }
@@ -403,10 +403,10 @@ impl AmplitudeTracker {
         let v = self.squares.second[V] + PRIOR_WEIGHT * v0;
         let a = self.squares.second[A] + PRIOR_WEIGHT * a0;
         let mut gradient = [0.0; TRACKER_CONTINUOUS];
-        if !(w > 0.0) {
+        if w <= 0.0 {
             return (self.prior, gradient);
         }
-        let Some((estimate, [by_v2, by_a2])) = self.from_means(v / w, a / w) else {
+        let Some((estimate, [by_v2, by_a2])) = self.of_means(v / w, a / w) else {
             return (self.prior, gradient);
         };
         // The means are v/w and a/w: by w, -(v by_v2 + a by_a2)/w^2.
@@ -579,6 +579,72 @@ mod tests {
             let mut s = good;
             s[i] = bad;
             assert!(tracker.set_state(&s).is_err(), "state[{i}] = {bad}");
+        }
+    }
+    /// The estimator as ODEs (Model Exchange): from all filters 0 its estimate is the prior,
+    /// and states a solver's noise away from there (1e-18, of either sign, against the prior's
+    /// share 1e-6 of mean squares of order 1e-5 and 1e-3) move it by no more than their size
+    /// relative to that share: continuous, where Co-Simulation's formula of the same tiny
+    /// numbers jumps (to 1 m from the prior's 1 mm here). The flag that says so is saved
+    /// (2 at position 1) and restored; Co-Simulation's saved states never carry it.
+    #[test]
+    fn the_continuous_estimate_starts_at_the_prior_and_leaves_it_smoothly() {
+        let (prior, omega) = (0.001, 6.0);
+        let mut tracker = AmplitudeTracker::new(2.0, 0.3, prior, omega);
+        assert_eq!(tracker.state()[1], 0.0);
+        tracker
+            .set_continuous_state(&[0.0; TRACKER_CONTINUOUS])
+            .expect("finite");
+        assert_eq!(tracker.state()[1], 2.0);
+        let start = tracker.estimate();
+        assert!((start / prior - 1.0).abs() < 1e-14, "{start}");
+        tracker
+            .set_continuous_state(&[0.0, 1e-18, -1e-18, 1e-18, 1e-18, 1e-18, -1e-18])
+            .expect("finite");
+        assert!((tracker.estimate() / prior - 1.0).abs() < 1e-6);
+        let noisy = [0.0, 1e-18, 1e-18, 1e-18, 2e-18, 1e-18, 1e-18];
+        tracker.set_continuous_state(&noisy).expect("finite");
+        let moved = tracker.estimate();
+        assert!((moved / prior - 1.0).abs() < 1e-6, "{moved}");
+        let mut cs = AmplitudeTracker::new(2.0, 0.3, prior, omega);
+        let mut saved = tracker.state();
+        saved[1] = 0.0;
+        cs.set_state(&saved).expect("in range");
+        assert!(cs.estimate() > 100.0 * prior, "{}", cs.estimate());
+        let mut restored = AmplitudeTracker::new(2.0, 0.3, prior, omega);
+        restored.set_state(&tracker.state()).expect("in range");
+        assert_eq!(restored, tracker);
+        assert_eq!(restored.estimate(), moved);
+    }
+
+    /// The gradient of the continuous estimate against central differences of it, with the
+    /// velocity rebuilt and measured, filters mid-way.
+    #[test]
+    fn the_continuous_estimates_gradient_is_its_change() {
+        for measured in [false, true] {
+            let mut tracker = AmplitudeTracker::new(1.5, 0.3, 0.004, 6.0);
+            if measured {
+                tracker.sees_velocity(0.1);
+            }
+            let s = [0.02, 8e-5, 5e-5, 2e-3, 1.2e-3, 0.6, 0.35];
+            tracker.set_continuous_state(&s).expect("finite");
+            let (_, gradient) = tracker.continuous_estimate();
+            for k in 0..TRACKER_CONTINUOUS {
+                let h = 1e-5 * s[k];
+                let at = |x: f64| {
+                    let mut t = tracker.clone();
+                    let mut p = s;
+                    p[k] = x;
+                    t.set_continuous_state(&p).expect("finite");
+                    t.estimate()
+                };
+                let fd = (at(s[k] + h) - at(s[k] - h)) / (2.0 * h);
+                assert!(
+                    (gradient[k] - fd).abs() <= 1e-7 * fd.abs().max(1e-9),
+                    "measured {measured}, {k}: {} vs {fd}",
+                    gradient[k]
+                );
+            }
         }
     }
 }

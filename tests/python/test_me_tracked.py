@@ -25,8 +25,11 @@ OUT = ["slosh.x", "slosh.v", "force", "A_e.estimate", "zeta.effective"]
 # CVode's error over the 4000 restarts, as a fraction of each signal's peak (measured: see
 # docs/MODEL_EXCHANGE.md, Verified): it falls with the tolerance, so it is the solver's; a wrong
 # equation (a different estimator, a missing prior weight, another damping) would leave an
-# error that does not fall.
-BOUND = {1e-10: 2e-6, 1e-12: 5e-8}
+# error that does not fall. The estimate's largest error is at the first samples, where the
+# filters are still below the solver's absolute tolerance (measured 9.9e-6 and 1.5e-7 at
+# t = 0.01 s; 4.7e-8 and 1.7e-9 after 1 s); the motion's grows with time (the phase error).
+BOUND = {1e-10: 1e-6, 1e-12: 5e-8}
+ESTIMATE_BOUND = {1e-10: 3e-5, 1e-12: 5e-7}
 
 
 def staircase():
@@ -64,12 +67,43 @@ def test_tracked_defaults_against_the_estimators_odes(fmu_path, reference, rtol)
                        stop_time=T_END)
     res = at(res, t)
     err = {k: R.rel_err(res[k], reference[k]) for k in OUT}
+    late = t >= 1.0
+    e_late = R.rel_err(res["A_e.estimate"][late], reference["A_e.estimate"][late],
+                       np.max(np.abs(reference["A_e.estimate"])))
     print(f"Tracked defaults in ME (CVode {rtol:g}, {T_END:g} s) vs DOP853 1e-12: "
           + ", ".join(f"{k} {e:.2e}" for k, e in err.items())
+          + f" (A_e.estimate from 1 s on {e_late:.2e})"
           + f"; A_e.estimate at the end {1e3 * res['A_e.estimate'][-1]:.4f} mm")
     # The prior at the start, as Co-Simulation's estimate before its first step.
     assert abs(res["A_e.estimate"][0] - R.TLD().A_e) < 1e-12
     # The estimate has left the prior (5 mm) for the 4 mm driven.
     assert abs(res["A_e.estimate"][-1] - AMP) < 0.05 * AMP
     for k, e in err.items():
-        assert e < BOUND[rtol], (k, e)
+        bound = ESTIMATE_BOUND if k in ("A_e.estimate", "zeta.effective") else BOUND
+        assert e < bound[rtol], (k, e)
+
+
+def test_tracked_defaults_run_at_rtol_1e10_under_a_sampled_input(fmu_path):
+    """What stopped CVode at t = 0.006 s (mxstep): the defaults under an input sampled every
+    10 ms (not a staircase). fmpy sets such an input, interpolated, in its root function, i.e.
+    at every internal CVode step (TLD.fmu has event indicators), so the right-hand side jumps a
+    little at every step; the rebuilt velocity integrates base.a as slosh.v does, and with the
+    prior's velocity as its nominal (25 times slosh.v's) its absolute tolerance forced steps
+    too short. Now it has slosh.v's nominal and runs, as amplitude = Fixed does. 3 s here
+    (20 s take 2 min: about 800,000 derivative evaluations, the input's jumps); at rtol 1e-12
+    amplitude = Fixed stops there too (docs/MODEL_EXCHANGE.md, Left)."""
+    t_end = 3.0
+    t = DT * np.arange(int(round(t_end / DT)) + 1)
+    signal = np.zeros(len(t), dtype=[("time", np.float64), ("base.a", np.float64)])
+    signal["time"], signal["base.a"] = t, -W ** 2 * AMP * np.sin(W * t)
+    runs = {rtol: at(simulate_fmu(str(fmu_path), input=signal, output=["slosh.x", "A_e.estimate"],
+                                  fmi_type="ModelExchange", solver="CVode",
+                                  relative_tolerance=rtol, output_interval=DT, stop_time=t_end),
+                     t)
+            for rtol in (1e-8, 1e-10)}
+    dx = R.rel_err(runs[1e-10]["slosh.x"], runs[1e-8]["slosh.x"])
+    print(f"defaults, sampled input, {t_end:g} s: slosh.x at rtol 1e-10 vs 1e-8 {dx:.1e} of peak")
+    # Both see the input set at their own steps, so they differ by that input's timing (first
+    # order in CVode's steps), not by the tolerances alone: bounded, not small.
+    assert dx < 5e-2
+    assert np.all(np.isfinite(runs[1e-10]["A_e.estimate"]))
