@@ -15,34 +15,18 @@ use tld_fmu::fmi::vars::vr;
 const STATES: usize = tld_fmu::model::continuous::ALL_STATES;
 const NSD: i32 = 2;
 const SCREENS: i32 = 4;
-/// The estimator's states, in state order after the oscillators'.
-const TRACKER: [&str; 7] = [
-    "A_e.tracker.v",
-    "A_e.tracker.v2[1]",
-    "A_e.tracker.v2[2]",
-    "A_e.tracker.a2[1]",
-    "A_e.tracker.a2[2]",
-    "A_e.tracker.weight[1]",
-    "A_e.tracker.weight[2]",
-];
-
-/// The continuous states' names in state order.
+/// The continuous states' names in state order: S^2's six, the modes' bank, the estimator's
+/// (the rebuilt velocity, then each filter pair of v^2, a^2 and 1).
 fn state_names() -> Vec<String> {
-    let mut names: Vec<String> = [
-        "slosh.x",
-        "slosh.v",
-        "energy.input",
-        "energy.dissipated",
-        "impact.z",
-        "impact.v",
-    ]
-    .map(String::from)
-    .into();
+    let mut names: Vec<String> = S2_NAMES.map(String::from).into();
     for n in 2..=10 {
         names.push(format!("mode[{n}].x"));
         names.push(format!("mode[{n}].v"));
     }
-    names.extend(TRACKER.map(String::from));
+    names.push("A_e.tracker.v".into());
+    for lane in ["v2", "a2", "weight"] {
+        names.extend((1..=2).map(|k| format!("A_e.tracker.{lane}[{k}]")));
+    }
     assert_eq!(names.len(), STATES);
     names
 }
@@ -70,16 +54,18 @@ fn unknowns() -> Vec<u32> {
 fn running(model: i32, modes: i32, law: i32, measured: bool) -> Instance {
     let inst = Instance::model_exchange(&format!("jac-tracked-{model}-{law}-{measured}"));
     assert_eq!(inst.setup(), OK);
-    assert_eq!(inst.set_integer(vr::MODEL, model), OK);
-    assert_eq!(inst.set_integer(vr::MODES, modes), OK);
-    assert_eq!(inst.set_integer(vr::DAMPING, law), OK);
-    assert_eq!(inst.set_integer(vr::SCREENS_COUNT, 2), OK);
-    assert_eq!(inst.set_integer(vr::AMPLITUDE, 2), OK);
+    let integers = [
+        (vr::MODEL, model),
+        (vr::MODES, modes),
+        (vr::DAMPING, law),
+        (vr::SCREENS_COUNT, 2),
+        (vr::AMPLITUDE, 2),
+    ];
+    for (r, value) in integers {
+        assert_eq!(inst.set_integer(r, value), OK, "{r}");
+    }
     assert_eq!(inst.set_real(vr::AMPLITUDE_TAU, 0.7), OK);
-    assert_eq!(inst.enter(), OK);
-    assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
-    assert_eq!(inst.new_discrete_states().0, OK);
-    assert_eq!(inst.enter_continuous_time_mode(), OK);
+    inst.start_continuous_time();
     if measured {
         assert_eq!(inst.set_real(vr::BASE_V, 0.03), OK);
         assert_eq!(inst.completed_integrator_step().1, (1, 0));
@@ -137,27 +123,10 @@ fn check(inst: &Instance, what: &str, p: &[f64]) -> f64 {
         let j = jacobian_column(inst, &unknowns, known);
         // Relative steps (the estimator's states are small numbers); 1e-6 where 0.
         let h = if p[k] != 0.0 { 1e-4 * p[k].abs() } else { 1e-6 };
-        let (mut plus, mut minus) = (p.to_vec(), p.to_vec());
-        plus[k] += h;
-        minus[k] -= h;
-        put(inst, &plus);
-        let up = values(inst);
-        put(inst, &minus);
-        let down = values(inst);
-        for i in 0..j.len() {
-            let fd = (up[i] - down[i]) / (2.0 * h);
-            // Truncation (relative: the estimate and the laws are curved) and rounding.
-            let tol = 1e-6 * j[i].abs().max(fd.abs())
-                + 1e3 * f64::EPSILON * (up[i].abs() + down[i].abs()) / h;
-            let err = (j[i] - fd).abs();
-            assert!(
-                err <= tol,
-                "{what}: d[{}]/d[{known}] = {} by J d, {fd} by differences",
-                unknowns[i],
-                j[i]
-            );
-            worst = worst.max(err / tol.max(f64::MIN_POSITIVE));
-        }
+        let (up, down) = values_either_side(p, k, h, |q| put(inst, q), || values(inst));
+        worst = worst.max(against_differences(&j, &up, &down, h, |i| {
+            format!("{what}: d[{}]/d[{known}]", unknowns[i])
+        }));
     }
     put(inst, p);
     worst

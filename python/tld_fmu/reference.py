@@ -385,6 +385,16 @@ def harmonic_base(w, A, t):
     return A * np.sin(w * t), A * w * np.cos(w * t), -A * w ** 2 * np.sin(w * t)
 
 
+def staircase(t, a, name="base.a"):
+    """fmpy's input signal for the samples a at the times t, each held until the next: every
+    time after the first twice (the old value, then the new), so that every sample is an input
+    event where fmpy restarts its solver and the FMU sees exactly the held samples."""
+    signal = np.zeros(2 * len(t) - 1, dtype=[("time", np.float64), (name, np.float64)])
+    signal["time"][0::2], signal[name][0::2] = t, a
+    signal["time"][1::2], signal[name][1::2] = t[1:], a[:-1]
+    return signal
+
+
 def rel_err(a, b, scale=None):
     """max |a - b| / scale (scale defaults to max |b|)."""
     a, b = np.asarray(a, float), np.asarray(b, float)

@@ -36,10 +36,7 @@ def staircase():
     """Sample times t, samples a (held until the next sample) and fmpy's staircase signal."""
     t = DT * np.arange(int(round(T_END / DT)) + 1)
     a = -W ** 2 * AMP * np.sin(W * t)
-    signal = np.zeros(2 * len(t) - 1, dtype=[("time", np.float64), ("base.a", np.float64)])
-    signal["time"][0::2], signal["base.a"][0::2] = t, a
-    signal["time"][1::2], signal["base.a"][1::2] = t[1:], a[:-1]
-    return t, a, signal
+    return t, a, R.staircase(t, a)
 
 
 def at(result, t):
