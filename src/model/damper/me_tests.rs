@@ -176,9 +176,10 @@ fn states_beyond_a_hundred_tank_lengths_are_refused_and_change_nothing() {
 /// and the damping law into the damping. Every column (the 24 states, the estimator's 7,
 /// base.a, base.v) of every output, state derivative and estimator derivative against central
 /// differences of the outputs and derivatives themselves, for Linear (3 modes), Nonlinear and
-/// S^2 in flight, under NSD (Lambda inside its clamp) and Screens, with the velocity rebuilt
-/// and measured (base.v then enters the estimator's rates). The filters are set mid-way (the
-/// estimate neither the prior nor settled).
+/// S^2 with its impact mass in flight and resting on a wall, under NSD (Lambda inside its
+/// clamp) and Screens, with the velocity rebuilt and measured (base.v then enters the
+/// estimator's rates). The filters are set mid-way (the estimate neither the prior nor
+/// settled).
 #[test]
 fn a_tracked_amplitudes_tangent_is_its_change() {
     use crate::model::shallow_water::continuous::CELL_STATES;
@@ -186,7 +187,13 @@ fn a_tracked_amplitudes_tangent_is_its_change() {
     const NSD: f64 = 2.0;
     const SCREENS: f64 = 4.0;
     let mut cases = 0;
-    for (model, modes) in [(LINEAR, 3.0), (NONLINEAR, 1.0), (SLAMMING, 1.0)] {
+    let models = [
+        (LINEAR, 3.0, false),
+        (NONLINEAR, 1.0, false),
+        (SLAMMING, 1.0, false),
+        (SLAMMING, 1.0, true),
+    ];
+    for (model, modes, rest) in models {
         for law in [NSD, SCREENS] {
             for measured in [false, true] {
                 let p = params(model)
@@ -207,6 +214,16 @@ fn a_tracked_amplitudes_tangent_is_its_change() {
                 s[..6].copy_from_slice(&[0.02, -0.05, 0.4, 0.1, 0.03, 0.2]);
                 for (k, v) in s[BANK..BANK + 4].iter_mut().enumerate() {
                     *v = 0.004 * (k as f64 - 1.5);
+                }
+                if rest {
+                    // Pressed onto the wall +d/2 (the base accelerating towards -x), at rest.
+                    (s[IMPACT_Z], s[IMPACT_V]) = (0.05, 0.0);
+                    d.set_continuous_states(&s).expect("takes them");
+                    assert!(matches!(
+                        d.event(&held(-30.0)),
+                        Event::Impact { rests: true, .. }
+                    ));
+                    s = d.continuous_states();
                 }
                 // Mid-way filters of base motion about 3 mm at 5 rad/s (the mean squares of
                 // its velocity and acceleration, 1.1e-4 and 2.8e-3 when settled).
@@ -253,7 +270,7 @@ fn a_tracked_amplitudes_tangent_is_its_change() {
                     (m.continuous_derivatives(i), r)
                 };
                 let ((dp, rp), (dm, rm)) = (rates(&plus, &ip), rates(&minus, &im));
-                let case = format!("model {model}, law {law}, measured {measured}");
+                let case = format!("model {model} (rest {rest}), law {law}, measured {measured}");
                 for (u, got) in unknowns.iter().zip(&out) {
                     let fd = match *u {
                         Unknown::Output(o) => {
@@ -279,7 +296,7 @@ fn a_tracked_amplitudes_tangent_is_its_change() {
             }
         }
     }
-    assert_eq!(cases, 12);
+    assert_eq!(cases, 16);
 }
 
 /// J d of every output and every derivative against central differences of the outputs and
