@@ -46,10 +46,7 @@ fn running(name: &str, model: i32, eta: f64) -> Instance {
     assert_eq!(inst.set_integer(vr::DAMPING, 1), OK);
     assert_eq!(inst.set_real(vr::ZETA, 0.03), OK);
     assert_eq!(inst.set_integer(vr::AMPLITUDE, 1), OK);
-    assert_eq!(inst.enter(), OK);
-    assert_eq!(inst.exit(), OK, "{:?}", inst.logs());
-    assert_eq!(inst.new_discrete_states().0, OK);
-    assert_eq!(inst.enter_continuous_time_mode(), OK);
+    inst.start_continuous_time();
     inst
 }
 
@@ -76,7 +73,7 @@ fn values(inst: &Instance) -> Vec<f64> {
 }
 
 /// Set the states and inputs `p` (KNOWNS' order).
-fn put(inst: &Instance, p: &[f64; 7]) {
+fn put(inst: &Instance, p: &[f64]) {
     let mut states = [0.0; STATES];
     states[..N].copy_from_slice(&p[..N]);
     assert_eq!(inst.set_states(&states), OK, "{:?}", inst.logs());
@@ -107,29 +104,11 @@ fn check_point(inst: &Instance, what: &str, p: [f64; 7], cusp: bool) -> f64 {
         } else {
             1e-5 * typical[k]
         };
-        let (mut plus, mut minus) = (p, p);
-        plus[k] += h;
-        minus[k] -= h;
-        put(inst, &plus);
-        let up = values(inst);
-        put(inst, &minus);
-        let down = values(inst);
+        let (up, down) = values_either_side(&p, k, h, |q| put(inst, q), || values(inst));
         let names = unknowns();
-        for i in 0..j.len() {
-            let fd = (up[i] - down[i]) / (2.0 * h);
-            // Truncation (relative) and rounding of the values differenced.
-            let tol = 1e-6 * j[i].abs().max(fd.abs())
-                + 1e3 * f64::EPSILON * (up[i].abs() + down[i].abs()) / h;
-            let err = (j[i] - fd).abs();
-            assert!(
-                err <= tol,
-                "{what} at {p:?}: d[{}]/d[{}] = {} by J d, {fd} by differences",
-                names[i],
-                KNOWNS[k],
-                j[i]
-            );
-            worst = worst.max(err / tol.max(f64::MIN_POSITIVE));
-        }
+        worst = worst.max(against_differences(&j, &up, &down, h, |i| {
+            format!("{what} at {p:?}: d[{}]/d[{}]", names[i], KNOWNS[k])
+        }));
     }
     put(inst, &p);
     worst

@@ -18,14 +18,6 @@ use tld_fmu::fmi::vars::vr;
 const N: usize = tld_fmu::model::continuous::ALL_STATES;
 /// Those S^2 uses.
 const S2_STATES: usize = 6;
-const S2_NAMES: [&str; S2_STATES] = [
-    "slosh.x",
-    "slosh.v",
-    "energy.input",
-    "energy.dissipated",
-    "impact.z",
-    "impact.v",
-];
 /// Event indicators: the contact functions of the walls +d/2 and -d/2.
 const NZ: usize = 2;
 const S2: i32 = 3;

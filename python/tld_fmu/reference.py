@@ -268,6 +268,62 @@ def simulate_held_scipy(p: TLD, dt, a_held, rtol=1e-12, zeta=None):
     return dt * np.arange(N + 1), np.array(xs), np.array(vs)
 
 
+# The weight of the prior in Model Exchange's amplitude estimate (docs/MODEL_EXCHANGE.md, "the
+# estimator as states"): the prior's mean squares count as this much filtered data.
+PRIOR_WEIGHT = 1e-6
+
+
+def simulate_tracked_held_scipy(p: TLD, dt, a_held, tau=0.0, rtol=1e-12):
+    """Eq 2.11 with amplitude = Tracked as Model Exchange integrates it, solved by
+    solve_ivp(DOP853) restarted on every held interval: the damping ratio is p.zeta_of(A_e) at
+    the estimate A_e of the estimator's ODEs (docs/MODEL.md 2, docs/MODEL_EXCHANGE.md), the
+    velocity rebuilt from base.a (base.v never set):
+        r' = a - w_c r,  w_c = w_f/20
+        f1' = (s - f1)/tau,  f2' = (f1 - f2)/tau   for s = r^2, a^2 and 1 (the weight)
+        <v^2> = (f2[r^2] + e V0)/(f2[1] + e),  <a^2> = (f2[a^2] + e A0)/(f2[1] + e)
+        A_e = sqrt(2) <a^2>^(1/2) / (<a^2>/<v^2> - w_c^2)    (the prior where that fails)
+    with e = PRIOR_WEIGHT and the prior's mean squares A0 = (A_p w_f^2)^2/2,
+    V0 = A0/(w_f^2 + w_c^2) (harmonic base motion of the prior amplitude A_p = p.A_e at w_f, its
+    velocity through the leak's gain). tau 0: two sloshing periods. Returns (t, x, v, A_e)
+    at the interval ends, from the state at rest with every filter at 0."""
+    from scipy.integrate import solve_ivp
+    w_f = p.omega_f
+    wc = 0.05 * w_f
+    tau = tau if tau > 0 else 2.0 * (2.0 * math.pi / w_f)
+    A0 = 0.5 * (p.A_e * w_f ** 2) ** 2
+    V0 = A0 / (w_f ** 2 + wc ** 2)
+
+    def estimate(y):
+        weight = y[8] + PRIOR_WEIGHT
+        v2 = (y[4] + PRIOR_WEIGHT * V0) / weight
+        a2 = (y[6] + PRIOR_WEIGHT * A0) / weight
+        if not (weight > 0 and v2 > 0 and a2 > 0):
+            return p.A_e
+        w2 = a2 / v2 - wc ** 2
+        return math.sqrt(2.0) * math.sqrt(a2) / w2 if w2 > 0 else p.A_e
+
+    def rhs(_, y, ab):
+        x, v, r = y[0], y[1], y[2]
+        c = 2.0 * p.zeta_of(estimate(y)) * w_f
+        return [v, -ab - c * v - float(p.Phi(x)), ab - wc * r,
+                (r * r - y[3]) / tau, (y[3] - y[4]) / tau,
+                (ab * ab - y[5]) / tau, (y[5] - y[6]) / tau,
+                (1.0 - y[7]) / tau, (y[7] - y[8]) / tau]
+
+    y = np.array([p.x0, p.v0] + [0.0] * 7)
+    scale = [p.a, p.a * w_f, p.A_e * w_f, (p.A_e * w_f) ** 2, (p.A_e * w_f) ** 2,
+             (p.A_e * w_f ** 2) ** 2, (p.A_e * w_f ** 2) ** 2, 1.0, 1.0]
+    atol = 1e-16 * np.array(scale)
+    xs, vs, es = [y[0]], [y[1]], [estimate(y)]
+    for k, ab in enumerate(np.asarray(a_held, dtype=float)):
+        sol = solve_ivp(rhs, (k * dt, (k + 1) * dt), y, method="DOP853", rtol=rtol, atol=atol,
+                        args=(float(ab),))
+        assert sol.success, sol.message
+        y = sol.y[:, -1]
+        xs.append(y[0]); vs.append(y[1]); es.append(estimate(y))
+    return dt * np.arange(len(a_held) + 1), np.array(xs), np.array(vs), np.array(es)
+
+
 # ------------------------------------------------------------------------------------------------
 # Linear model: exact solutions
 # ------------------------------------------------------------------------------------------------
@@ -327,6 +383,16 @@ def harmonic_base(w, A, t):
     """Base motion x = A sin(w t): returns (x, v, a) at times t."""
     t = np.asarray(t, dtype=float)
     return A * np.sin(w * t), A * w * np.cos(w * t), -A * w ** 2 * np.sin(w * t)
+
+
+def staircase(t, a, name="base.a"):
+    """fmpy's input signal for the samples a at the times t, each held until the next: every
+    time after the first twice (the old value, then the new), so that every sample is an input
+    event where fmpy restarts its solver and the FMU sees exactly the held samples."""
+    signal = np.zeros(2 * len(t) - 1, dtype=[("time", np.float64), (name, np.float64)])
+    signal["time"][0::2], signal[name][0::2] = t, a
+    signal["time"][1::2], signal[name][1::2] = t[1:], a[:-1]
+    return signal
 
 
 def rel_err(a, b, scale=None):

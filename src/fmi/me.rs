@@ -75,17 +75,18 @@ fn direction(knowns: &[u32], dv: &[f64]) -> Result<Direction, Refusal> {
                 // A cell: no equation of a model without cells reads it (and a model with cells
                 // has no directional derivatives).
                 None if matches!(cell_of(r), Some(Cell::State(_))) => continue,
-                // The estimator's: read by no equation with a fixed amplitude (and a tracked
-                // one has no directional derivatives).
-                None if matches!(tracker_of(r), Some((_, false))) => continue,
-                None => {
-                    return Err(refuse(format!(
-                        "fmi2GetDirectionalDerivative: value reference {r} is neither a \
-                         continuous state (slosh.x, slosh.v, energy.input, energy.dissipated, \
-                         impact.z, impact.v, mode[n].x, mode[n].v) nor an input (base.a, base.v, \
-                         base.x)"
-                    )));
-                }
+                None => match tracker_of(r) {
+                    // The estimator's (read by no equation with a fixed amplitude).
+                    Some((k, false)) => &mut d.tracker[k],
+                    _ => {
+                        return Err(refuse(format!(
+                            "fmi2GetDirectionalDerivative: value reference {r} is neither a \
+                             continuous state (slosh.x, slosh.v, energy.input, \
+                             energy.dissipated, impact.z, impact.v, mode[n].x, mode[n].v, \
+                             A_e.tracker.*) nor an input (base.a, base.v, base.x)"
+                        )));
+                    }
+                },
             },
         };
         *slot += change;
@@ -98,7 +99,10 @@ fn unknown(r: u32) -> Result<Unknown, Refusal> {
     if let Some(k) = DERIVATIVES.iter().position(|&d| d == r) {
         return Ok(Unknown::Derivative(k));
     }
-    if let (Some(Cell::Derivative(_)), _) | (_, Some((_, true))) = (cell_of(r), tracker_of(r)) {
+    if let Some((k, true)) = tracker_of(r) {
+        return Ok(Unknown::Tracker(k));
+    }
+    if let Some(Cell::Derivative(_)) = cell_of(r) {
         return Ok(Unknown::Frozen);
     }
     let real = index_of(r).is_some_and(|k| VARIABLES[k].ty == VarType::Real);

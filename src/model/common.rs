@@ -165,6 +165,12 @@ impl Common {
         self.damping.zeta(amplitude, self.tank.length, self.lambda)
     }
 
+    /// d zeta / d amplitude of [`Common::zeta`].
+    pub fn zeta_slope(&self, amplitude: f64) -> f64 {
+        self.damping
+            .zeta_slope(amplitude, self.tank.length, self.lambda)
+    }
+
     /// Total liquid mass, all tanks [kg].
     pub fn liquid_mass(&self) -> f64 {
         self.tank.liquid_mass() * f64::from(self.tanks)

@@ -18,9 +18,10 @@
 //! than [`ME_MODES`] modes.
 //!
 //! Directional derivatives (J d, for a host's implicit solver): the exact derivatives of the
-//! same rates in the states and the base acceleration, the damping ratio fixed (amplitude =
-//! Fixed), from the oscillator's restoring force f(x) and its slope f'(x) (Phi of Eq 2.13 and
-//! dPhi/dx; finite at x = 0 for every eta >= 1).
+//! same rates in the states, the base acceleration and the damping ratio (which amplitude =
+//! Tracked moves with the estimator's states: the damper gives its change), from the
+//! oscillator's restoring force f(x) and its slope f'(x) (Phi of Eq 2.13 and dPhi/dx; finite at
+//! x = 0 for every eta >= 1).
 //!
 //! [`Model::rate`]: super::Model::rate
 
@@ -57,11 +58,17 @@ pub const RATES: [Output; 4] = [
 pub struct Direction {
     /// Changes of [x, v, energy.input, energy.dissipated].
     pub states: [f64; STATES],
-    /// Changes of the inputs base.a [m/s^2], base.v [m/s], base.x [m]. With amplitude = Fixed
-    /// no equation reads base.v or base.x: their columns of J are 0.
+    /// Changes of the inputs base.a [m/s^2], base.v [m/s], base.x [m]. No equation reads
+    /// base.x, and base.v only the estimator's once it measures the velocity: their columns
+    /// of J are 0 otherwise.
     pub a: f64,
     pub v: f64,
     pub x: f64,
+    /// Changes of the amplitude estimator's states (amplitude = Tracked).
+    pub tracker: [f64; crate::physics::amplitude::TRACKER_CONTINUOUS],
+    /// The change of the damping ratio they make (through the estimate and the damping law;
+    /// the damper sets it, 0 with a fixed amplitude).
+    pub zeta: f64,
 }
 
 /// J d of the offered models' continuous part.
@@ -99,6 +106,7 @@ impl AnyModel {
             dx: d.states[0],
             dv: d.states[1],
             da: d.a,
+            dzeta: d.zeta,
         };
         // The energies' derivatives do not read the energies: their columns are 0.
         let mut t = Tangent {
@@ -120,7 +128,7 @@ impl AnyModel {
             t.impact_z = d.states[IMPACT_Z];
         }
         if let AnyModel::Linear(m) = self {
-            let bank = m.bank_tangent(a, &d.states[BANK..], d.a);
+            let bank = m.bank_tangent(a, &d.states[BANK..], d.a, d.zeta);
             t.derivatives[BANK..BANK + bank.derivatives.len()].copy_from_slice(&bank.derivatives);
             t.derivatives[2] += bank.power;
             t.derivatives[3] += bank.dissipation;

@@ -63,7 +63,7 @@ impl Damper {
                 // The velocity rebuild leaks at w_f/20: 0.5 % gain error at w_f/2, undone exactly.
                 (
                     prior,
-                    Some(AmplitudeTracker::new(tau, 0.05 * omega_f, prior)),
+                    Some(AmplitudeTracker::new(tau, 0.05 * omega_f, prior, omega_f)),
                 )
             }
         };

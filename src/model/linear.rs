@@ -50,6 +50,7 @@ impl LinearMode {
             mass: self.mass,
             v: s.v,
             c: 2.0 * self.mode.zeta * w,
+            c_per_zeta: 2.0 * w,
             restoring: w2 * s.x,
             slope: w2,
         }

@@ -363,6 +363,7 @@ impl Nonlinear {
             mass: self.mass,
             v,
             c: self.tld.c,
+            c_per_zeta: 2.0 * self.omega_f,
             restoring: self.tld.stiffness.force(x),
             slope: self.tld.stiffness.slope(x),
         }

@@ -3,24 +3,27 @@
 
 use super::Output;
 
-/// One oscillator now: mass [kg], v, damping c [1/s], restoring force per unit mass f(x) and
-/// its slope f'(x).
+/// One oscillator now: mass [kg], v, damping c [1/s] and its change by the damping ratio
+/// (c = 2 zeta omega: 2 omega), restoring force per unit mass f(x) and its slope f'(x).
 #[derive(Clone, Copy, Debug)]
 pub struct Oscillator {
     pub mass: f64,
     pub v: f64,
     pub c: f64,
+    pub c_per_zeta: f64,
     pub restoring: f64,
     pub slope: f64,
 }
 
-/// A change of one oscillator's state, displacement `dx` and velocity `dv`, and of the base
-/// acceleration `da`: the direction d of a directional derivative J d.
+/// A change of one oscillator's state, displacement `dx` and velocity `dv`, of the base
+/// acceleration `da` and of the damping ratio `dzeta` (amplitude = Tracked: the estimate's
+/// change through the damping law): the direction d of a directional derivative J d.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Change {
     pub dx: f64,
     pub dv: f64,
     pub da: f64,
+    pub dzeta: f64,
 }
 
 impl Oscillator {
@@ -30,27 +33,29 @@ impl Oscillator {
     }
 
     /// J d of [`rate`] for this oscillator alone (the fundamental one, no free masses) under
-    /// base acceleration `a`, with the damping c fixed: the exact change of the rates of x, v
-    /// and of the two energies for the change `d`. f(x) enters through its slope f'(x) only.
-    /// None for the outputs whose rate is not a state's derivative.
+    /// base acceleration `a`: the exact change of the rates of x, v and of the two energies for
+    /// the change `d`, the damping changing by dc = 2 omega dzeta. f(x) enters through its
+    /// slope f'(x) only. None for the outputs whose rate is not a state's derivative.
     pub fn rate_tangent(&self, which: Output, a: f64, d: Change) -> Option<f64> {
         let (m, c, v) = (self.mass, self.c, self.v);
-        // d(x'') = -da - c dv - f'(x) dx.
-        let acceleration = -d.da - c * d.dv - self.slope * d.dx;
+        let dc = self.c_per_zeta * d.dzeta;
+        // d(x'') = -da - c dv - v dc - f'(x) dx.
+        let acceleration = -d.da - c * d.dv - v * dc - self.slope * d.dx;
         Some(match which {
             Output::X => d.dv,
             Output::V => acceleration,
             // d(-m a v) = -m (a dv + v da).
             Output::EnergyInput => -m * (a * d.dv + v * d.da),
-            // d(m c v^2) = 2 m c v dv.
-            Output::EnergyDissipated => 2.0 * m * c * v * d.dv,
+            // d(m c v^2) = m (2 c v dv + v^2 dc).
+            Output::EnergyDissipated => m * v * (2.0 * c * d.dv + v * dc),
             _ => return None,
         })
     }
 
-    /// J d of the force on the tank m (c v + f(x)): m (c dv + f'(x) dx).
+    /// J d of the force on the tank m (c v + f(x)): m (c dv + v dc + f'(x) dx).
     pub fn force_tangent(&self, d: Change) -> f64 {
-        self.mass * (self.c * d.dv + self.slope * d.dx)
+        let dc = self.c_per_zeta * d.dzeta;
+        self.mass * (self.c * d.dv + self.v * dc + self.slope * d.dx)
     }
 
     /// J d of the stored energy m (v^2/2 + U(x)), U' = f: m (v dv + f(x) dx).

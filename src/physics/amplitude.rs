@@ -61,6 +61,15 @@ const A: usize = 1;
 /// Number of values in [`AmplitudeTracker::state`].
 pub const TRACKER_STATE: usize = 8;
 
+/// The weight of the prior in the estimate of the estimator as ODEs (Model Exchange): its mean
+/// squares are those of the prior's harmonic motion counted as this much filtered data, beside
+/// the filters' own (whose weight grows from 0 to 1). The estimate then starts at the prior and
+/// leaves it smoothly however small the filters still are, instead of jumping where a host's
+/// trial state puts a mean square at 0 (docs/MODEL_EXCHANGE.md): 1e-6 is 5e5 times the
+/// solver noise of the mean squares at rtol 1e-12 (their nominals are twice the prior's), and
+/// moves the estimate from Co-Simulation's formula by 1e-6 relative once the filters are full.
+pub const PRIOR_WEIGHT: f64 = 1e-6;
+
 /// What an update takes from the interval's length alone: computed for the first interval of a
 /// length and kept while the host's step stays the same (three exponentials per step otherwise,
 /// most of the tracker's cost). The same expressions as computed afresh: the same bits.
@@ -89,8 +98,13 @@ pub struct AmplitudeTracker {
     tau: f64,
     leak: f64,
     prior: f64,
+    /// The frequency of the prior's harmonic motion [rad/s] ([`PRIOR_WEIGHT`]).
+    prior_omega: f64,
     rebuilt_v: f64,
     measured_v_seen: bool,
+    /// The estimator runs as ODEs in a host's solver (Model Exchange): its estimate counts the
+    /// prior as [`PRIOR_WEIGHT`] of data ([`AmplitudeTracker::continuous_estimate`]).
+    continuous: bool,
     /// The mean squares of the base velocity (lane `V`) and acceleration (lane `A`).
     squares: MeanSquare<2>,
     /// The filters' response to a constant 1 (their normalisation).
@@ -106,28 +120,32 @@ impl PartialEq for AmplitudeTracker {
             self.tau,
             self.leak,
             self.prior,
+            self.prior_omega,
             self.rebuilt_v,
-            self.measured_v_seen,
         ) == (
             other.tau,
             other.leak,
             other.prior,
+            other.prior_omega,
             other.rebuilt_v,
-            other.measured_v_seen,
-        ) && (self.squares, self.weight) == (other.squares, other.weight)
+        ) && (self.measured_v_seen, self.continuous) == (other.measured_v_seen, other.continuous)
+            && (self.squares, self.weight) == (other.squares, other.weight)
     }
 }
 
 impl AmplitudeTracker {
     /// `tau`: filter time constant [s]; `leak`: corner w_c of the velocity rebuild [rad/s];
-    /// `prior`: the estimate before any data.
-    pub fn new(tau: f64, leak: f64, prior: f64) -> Self {
+    /// `prior`: the estimate before any data, taken as harmonic motion at `prior_omega` [rad/s]
+    /// where the estimator runs as ODEs ([`PRIOR_WEIGHT`]).
+    pub fn new(tau: f64, leak: f64, prior: f64, prior_omega: f64) -> Self {
         AmplitudeTracker {
             tau,
             leak,
             prior,
+            prior_omega,
             rebuilt_v: 0.0,
             measured_v_seen: false,
+            continuous: false,
             squares: MeanSquare::default(),
             weight: MeanSquare::default(),
             coefficients: Coefficients::NONE,
@@ -208,9 +226,10 @@ impl AmplitudeTracker {
     }
 
     /// Take the continuous part (as [`AmplitudeTracker::continuous_state`] gives it) from a
-    /// host's solver; the velocity source stays. Any finite values are taken: the filters start
-    /// at 0, and a solver's trial state may put a mean square or weight slightly below 0, which
-    /// [`AmplitudeTracker::estimate`] reads as 0. Err (nothing taken) for a non-finite value.
+    /// host's solver; the velocity source stays, and the estimator is one of ODEs from now on
+    /// ([`AmplitudeTracker::continuous_estimate`]). Any finite values are taken: a solver's
+    /// trial state may put a mean square or weight slightly below 0, far less than the prior's
+    /// share. Err (nothing taken) for a non-finite value.
     pub fn set_continuous_state(&mut self, s: &[f64; TRACKER_CONTINUOUS]) -> Result<(), String> {
         if s.iter().any(|v| !v.is_finite()) {
             return Err("amplitude estimator state not finite".into());
@@ -219,17 +238,23 @@ impl AmplitudeTracker {
         saved[0] = s[0];
         saved[2..].copy_from_slice(&s[1..]);
         self.take_state(&saved);
+        self.continuous = true;
         Ok(())
+    }
+
+    /// The velocity whose square the first filter of lane `V` takes in.
+    fn velocity(&self, measured: f64) -> f64 {
+        if self.measured_v_seen {
+            measured
+        } else {
+            self.rebuilt_v
+        }
     }
 
     /// The time derivatives of [`AmplitudeTracker::continuous_state`] under the base
     /// acceleration `accel` and velocity `velocity`: v' = a - w_c v and each filter pair's.
     pub fn continuous_rates(&self, accel: f64, velocity: f64) -> [f64; TRACKER_CONTINUOUS] {
-        let v = if self.measured_v_seen {
-            velocity
-        } else {
-            self.rebuilt_v
-        };
+        let v = self.velocity(velocity);
         let (first, second) = self.squares.rates(self.tau, [v * v, accel * accel]);
         let ([w1], [w2]) = self.weight.rates(self.tau, [1.0]);
         [
@@ -243,11 +268,37 @@ impl AmplitudeTracker {
         ]
     }
 
-    /// The evolving part of the estimator, for saving the state.
+    /// J d of [`AmplitudeTracker::continuous_rates`]: their exact change for the change `d` of
+    /// the continuous state and `da`, `dv` of the base acceleration and velocity (the rates
+    /// are linear but for the squares of the velocity and the acceleration).
+    pub fn rates_tangent(
+        &self,
+        accel: f64,
+        velocity: f64,
+        d: &[f64; TRACKER_CONTINUOUS],
+        da: f64,
+        dv: f64,
+    ) -> [f64; TRACKER_CONTINUOUS] {
+        let dv = if self.measured_v_seen { dv } else { d[0] };
+        let d_square = 2.0 * self.velocity(velocity) * dv;
+        let tau = self.tau;
+        [
+            da - self.leak * d[0],
+            (d_square - d[1]) / tau,
+            (d[1] - d[2]) / tau,
+            (2.0 * accel * da - d[3]) / tau,
+            (d[3] - d[4]) / tau,
+            -d[5] / tau,
+            (d[5] - d[6]) / tau,
+        ]
+    }
+
+    /// The evolving part of the estimator, for saving the state: the flag at position 1 is
+    /// 1 once the velocity is measured, plus 2 once the estimator runs as ODEs.
     pub fn state(&self) -> [f64; TRACKER_STATE] {
         [
             self.rebuilt_v,
-            f64::from(u8::from(self.measured_v_seen)),
+            f64::from(u8::from(self.measured_v_seen) + 2 * u8::from(self.continuous)),
             self.squares.first[V],
             self.squares.second[V],
             self.squares.first[A],
@@ -261,7 +312,7 @@ impl AmplitudeTracker {
     pub fn set_state(&mut self, s: &[f64; TRACKER_STATE]) -> Result<(), String> {
         if s.iter().any(|v| !v.is_finite())
             || s[2..].iter().any(|v| *v < 0.0)
-            || !matches!(s[1], 0.0 | 1.0)
+            || !matches!(s[1], 0.0 | 1.0 | 2.0 | 3.0)
         {
             return Err("amplitude estimator state out of range".into());
         }
@@ -272,7 +323,8 @@ impl AmplitudeTracker {
     /// Take a saved state as it is (checked by the caller).
     fn take_state(&mut self, s: &[f64; TRACKER_STATE]) {
         self.rebuilt_v = s[0];
-        self.measured_v_seen = s[1] == 1.0;
+        self.measured_v_seen = matches!(s[1], 1.0 | 3.0);
+        self.continuous = s[1] >= 2.0;
         self.squares = MeanSquare {
             first: [s[2], s[4]],
             second: [s[3], s[5]],
@@ -283,35 +335,85 @@ impl AmplitudeTracker {
         };
     }
 
-    /// The current amplitude estimate [m]: a mean square or weight below 0 (a host solver's
-    /// trial state) counts as 0, so any finite state gives a finite estimate.
+    /// The current amplitude estimate [m]: Co-Simulation's of the filters (a mean square or
+    /// weight below 0 counts as 0, so any finite state gives a finite estimate), or, once the
+    /// estimator runs as ODEs, [`AmplitudeTracker::continuous_estimate`]'s.
     pub fn estimate(&self) -> f64 {
+        if self.continuous {
+            return self.continuous_estimate().0;
+        }
         let w = self.weight.second[0].max(0.0);
         if w <= 0.0 {
             return self.prior;
         }
-        let (v2, a2) = (
+        self.of_means(
             self.squares.second[V].max(0.0) / w,
             self.squares.second[A].max(0.0) / w,
-        );
+        )
+        .map_or(self.prior, |(estimate, _)| estimate)
+    }
+
+    /// The estimate from the mean squares `v2` of the velocity and `a2` of the acceleration,
+    /// with its partial derivatives by them; None where they give none (the prior stands).
+    fn of_means(&self, v2: f64, a2: f64) -> Option<(f64, [f64; 2])> {
         if !(a2 > 0.0 && v2 > 0.0) {
-            return self.prior;
+            return None;
         }
-        let estimate = if self.measured_v_seen {
-            std::f64::consts::SQRT_2 * v2 / a2.sqrt()
+        let (estimate, slopes) = if self.measured_v_seen {
+            let e = std::f64::consts::SQRT_2 * v2 / a2.sqrt();
+            (e, [e / v2, -0.5 * e / a2])
         } else {
             // The rebuilt velocity has <v^2> = <a^2> / (w^2 + w_c^2): solve for w^2.
             let w2 = a2 / v2 - self.leak * self.leak;
             if w2 <= 0.0 {
-                return self.prior;
+                return None;
             }
-            std::f64::consts::SQRT_2 * a2.sqrt() / w2
+            let e = std::f64::consts::SQRT_2 * a2.sqrt() / w2;
+            (
+                e,
+                [e * a2 / (v2 * v2 * w2), e * (0.5 / a2 - 1.0 / (v2 * w2))],
+            )
         };
-        if estimate.is_finite() {
-            estimate
+        estimate.is_finite().then_some((estimate, slopes))
+    }
+
+    /// The mean squares [<v^2>, <a^2>] of the prior's harmonic motion (amplitude `prior` at
+    /// `prior_omega`), of the velocity the estimator takes in (rebuilt: through the leak's
+    /// gain).
+    fn prior_means(&self) -> [f64; 2] {
+        let w = self.prior_omega;
+        let a2 = 0.5 * (self.prior * w * w).powi(2);
+        let v2 = if self.measured_v_seen {
+            0.5 * (self.prior * w).powi(2)
         } else {
-            self.prior
+            a2 / (w * w + self.leak * self.leak)
+        };
+        [v2, a2]
+    }
+
+    /// The estimate of the estimator as ODEs, and its gradient by the continuous state (in
+    /// [`AmplitudeTracker::continuous_state`]'s order): the prior's mean squares count as
+    /// [`PRIOR_WEIGHT`] of data beside the filters', so the estimate is the prior at the start
+    /// (all filters 0) and a smooth function of the filters from there; where even that gives
+    /// no estimate (a mean square or weight below minus the prior's share, or w^2 <= 0) it
+    /// is the prior, its gradient 0.
+    pub fn continuous_estimate(&self) -> (f64, [f64; TRACKER_CONTINUOUS]) {
+        let [v0, a0] = self.prior_means();
+        let w = self.weight.second[0] + PRIOR_WEIGHT;
+        let v = self.squares.second[V] + PRIOR_WEIGHT * v0;
+        let a = self.squares.second[A] + PRIOR_WEIGHT * a0;
+        let mut gradient = [0.0; TRACKER_CONTINUOUS];
+        if w <= 0.0 {
+            return (self.prior, gradient);
         }
+        let Some((estimate, [by_v2, by_a2])) = self.of_means(v / w, a / w) else {
+            return (self.prior, gradient);
+        };
+        // The means are v/w and a/w: by w, -(v by_v2 + a by_a2)/w^2.
+        gradient[2] = by_v2 / w;
+        gradient[4] = by_a2 / w;
+        gradient[6] = -(v * by_v2 + a * by_a2) / (w * w);
+        (estimate, gradient)
     }
 }
 
@@ -330,7 +432,7 @@ mod tests {
         let wf = 5.6389f64;
         let (w, leak) = (ratio * wf, 0.05 * wf);
         let tau = 2.0 * std::f64::consts::TAU / wf;
-        let mut tracker = AmplitudeTracker::new(tau, leak, 0.001);
+        let mut tracker = AmplitudeTracker::new(tau, leak, 0.001, wf);
         let (amp, h) = (0.005, 0.01);
         let want = reference(amp, w, h);
         let (mut sum, mut n) = (0.0, 0.0);
@@ -390,7 +492,7 @@ mod tests {
     /// while the filters themselves hold only 1 - e^(-t/tau) of it (and the square of that).
     #[test]
     fn estimate_is_normalised_from_the_first_update() {
-        let mut tracker = AmplitudeTracker::new(2.0, 0.3, 0.001);
+        let mut tracker = AmplitudeTracker::new(2.0, 0.3, 0.001, 6.0);
         let (a, v) = (-0.8, 0.05);
         let want = std::f64::consts::SQRT_2 * v * v / 0.8;
         for k in 1..=20 {
@@ -408,7 +510,7 @@ mod tests {
     /// the prior, not 0). Guards the v2 > 0 half of the guard (>= or || would answer 0).
     #[test]
     fn no_estimate_before_the_rebuilt_velocity_moves() {
-        let mut tracker = AmplitudeTracker::new(2.0, 0.3, 0.001);
+        let mut tracker = AmplitudeTracker::new(2.0, 0.3, 0.001, 6.0);
         tracker.update(0.05, -0.8, 0.0);
         assert_eq!(tracker.estimate(), 0.001);
         tracker.update(0.05, -0.8, 0.0);
@@ -422,7 +524,7 @@ mod tests {
     #[test]
     fn packed_updates_are_the_scalar_recursion_to_the_bit() {
         let (tau, leak) = (1.3, 0.27);
-        let mut tracker = AmplitudeTracker::new(tau, leak, 0.002);
+        let mut tracker = AmplitudeTracker::new(tau, leak, 0.002, 5.4);
         let (mut rebuilt, mut seen) = (0.0f64, false);
         let mut filters = [[0.0f64; 2]; 3];
         for k in 0..400 {
@@ -466,7 +568,7 @@ mod tests {
     /// each bad value alone (not finite, a negative mean square, a flag not 0 or 1) refused.
     #[test]
     fn restored_state_is_checked_value_by_value() {
-        let mut tracker = AmplitudeTracker::new(2.0, 0.3, 0.001);
+        let mut tracker = AmplitudeTracker::new(2.0, 0.3, 0.001, 6.0);
         let fresh = tracker.state();
         assert!(tracker.set_state(&fresh).is_ok());
         tracker.update(0.05, -0.8, 0.05);
@@ -477,6 +579,72 @@ mod tests {
             let mut s = good;
             s[i] = bad;
             assert!(tracker.set_state(&s).is_err(), "state[{i}] = {bad}");
+        }
+    }
+    /// The estimator as ODEs (Model Exchange): from all filters 0 its estimate is the prior,
+    /// and states a solver's noise away from there (1e-18, of either sign, against the prior's
+    /// share 1e-6 of mean squares of order 1e-5 and 1e-3) move it by no more than their size
+    /// relative to that share: continuous, where Co-Simulation's formula of the same tiny
+    /// numbers jumps (to 1 m from the prior's 1 mm here). The flag that says so is saved
+    /// (2 at position 1) and restored; Co-Simulation's saved states never carry it.
+    #[test]
+    fn the_continuous_estimate_starts_at_the_prior_and_leaves_it_smoothly() {
+        let (prior, omega) = (0.001, 6.0);
+        let mut tracker = AmplitudeTracker::new(2.0, 0.3, prior, omega);
+        assert_eq!(tracker.state()[1], 0.0);
+        tracker
+            .set_continuous_state(&[0.0; TRACKER_CONTINUOUS])
+            .expect("finite");
+        assert_eq!(tracker.state()[1], 2.0);
+        let start = tracker.estimate();
+        assert!((start / prior - 1.0).abs() < 1e-14, "{start}");
+        tracker
+            .set_continuous_state(&[0.0, 1e-18, -1e-18, 1e-18, 1e-18, 1e-18, -1e-18])
+            .expect("finite");
+        assert!((tracker.estimate() / prior - 1.0).abs() < 1e-6);
+        let noisy = [0.0, 1e-18, 1e-18, 1e-18, 2e-18, 1e-18, 1e-18];
+        tracker.set_continuous_state(&noisy).expect("finite");
+        let moved = tracker.estimate();
+        assert!((moved / prior - 1.0).abs() < 1e-6, "{moved}");
+        let mut cs = AmplitudeTracker::new(2.0, 0.3, prior, omega);
+        let mut saved = tracker.state();
+        saved[1] = 0.0;
+        cs.set_state(&saved).expect("in range");
+        assert!(cs.estimate() > 100.0 * prior, "{}", cs.estimate());
+        let mut restored = AmplitudeTracker::new(2.0, 0.3, prior, omega);
+        restored.set_state(&tracker.state()).expect("in range");
+        assert_eq!(restored, tracker);
+        assert_eq!(restored.estimate(), moved);
+    }
+
+    /// The gradient of the continuous estimate against central differences of it, with the
+    /// velocity rebuilt and measured, filters mid-way.
+    #[test]
+    fn the_continuous_estimates_gradient_is_its_change() {
+        for measured in [false, true] {
+            let mut tracker = AmplitudeTracker::new(1.5, 0.3, 0.004, 6.0);
+            if measured {
+                tracker.sees_velocity(0.1);
+            }
+            let s = [0.02, 8e-5, 5e-5, 2e-3, 1.2e-3, 0.6, 0.35];
+            tracker.set_continuous_state(&s).expect("finite");
+            let (_, gradient) = tracker.continuous_estimate();
+            for k in 0..TRACKER_CONTINUOUS {
+                let h = 1e-5 * s[k];
+                let at = |x: f64| {
+                    let mut t = tracker.clone();
+                    let mut p = s;
+                    p[k] = x;
+                    t.set_continuous_state(&p).expect("finite");
+                    t.estimate()
+                };
+                let fd = (at(s[k] + h) - at(s[k] - h)) / (2.0 * h);
+                assert!(
+                    (gradient[k] - fd).abs() <= 1e-7 * fd.abs().max(1e-9),
+                    "measured {measured}, {k}: {} vs {fd}",
+                    gradient[k]
+                );
+            }
         }
     }
 }

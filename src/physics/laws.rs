@@ -76,6 +76,34 @@ impl DampingLaw {
     }
 }
 
+impl DampingLaw {
+    /// d zeta / d a_e of [`DampingLaw::zeta`] at `a_e`: 0 for the laws that ignore the
+    /// amplitude and where Lambda is clamped (at the clamp's ends, the clamped side's 0).
+    pub fn zeta_slope(&self, a_e: f64, length: f64, range: LambdaRange) -> f64 {
+        match *self {
+            DampingLaw::Constant(_) | DampingLaw::BoundaryLayer(_) => 0.0,
+            DampingLaw::Nsd { c, p } => {
+                let lambda = a_e / length;
+                if range.min < lambda && lambda < range.max {
+                    c * p * lambda.powf(p - 1.0) / length
+                } else {
+                    0.0
+                }
+            }
+            DampingLaw::Screens {
+                boundary,
+                per_response,
+                random: false,
+            } => crate::physics::screens::resonant_zeta_slope(boundary, per_response, a_e),
+            DampingLaw::Screens {
+                per_response,
+                random: true,
+                ..
+            } => crate::physics::screens::random_zeta_slope(per_response, a_e),
+        }
+    }
+}
+
 /// Frequency hardening ratio kappa(Lambda) of the NSD fit (the two branches meet at 0.03).
 pub fn nsd_kappa(lambda: f64) -> f64 {
     if lambda < 0.03 {
@@ -126,5 +154,41 @@ mod tests {
         assert!((nsd_kappa(0.03) - 1.0488).abs() < 1e-4);
         // Extrapolated far below the fitted range the fit would soften (kappa < 1): why Lambda is clamped.
         assert!(nsd_kappa(1e-5) < 1.0 && nsd_kappa(1e-3) > 1.0);
+    }
+    /// The laws' slopes by the amplitude against central differences of the laws: NSD inside
+    /// the clamp and 0 outside it, Screens (resonant and random), 0 for the constant laws.
+    #[test]
+    fn zeta_slopes_are_the_laws_changes() {
+        let laws = [
+            DampingLaw::Nsd { c: 0.5, p: 0.35 },
+            DampingLaw::Screens {
+                boundary: 0.015,
+                per_response: 2.5,
+                random: false,
+            },
+            DampingLaw::Screens {
+                boundary: 0.015,
+                per_response: 2.5,
+                random: true,
+            },
+            DampingLaw::Constant(0.02),
+            DampingLaw::BoundaryLayer(0.015),
+        ];
+        for law in laws {
+            for a_e in [1e-5, 0.002, 0.01, 0.05] {
+                let h = 1e-6 * a_e;
+                let fd =
+                    (law.zeta(a_e + h, 0.25, RANGE) - law.zeta(a_e - h, 0.25, RANGE)) / (2.0 * h);
+                let got = law.zeta_slope(a_e, 0.25, RANGE);
+                assert!(
+                    (got - fd).abs() <= 1e-6 * fd.abs().max(1e-9),
+                    "{law:?} at {a_e}: {got} vs {fd}"
+                );
+            }
+        }
+        // Lambda = 1e-5/0.25 below the clamp, 0.05/0.25 above: the NSD law is flat there.
+        let nsd = laws[0];
+        assert_eq!(nsd.zeta_slope(1e-5, 0.25, RANGE), 0.0);
+        assert_eq!(nsd.zeta_slope(0.05, 0.25, RANGE), 0.0);
     }
 }

@@ -140,6 +140,17 @@ pub fn resonant_zeta(boundary: f64, per_response: f64, a_e: f64) -> f64 {
     0.5 * (boundary + (boundary * boundary + 2.0 * per_response * a_e).sqrt())
 }
 
+/// d zeta / d a_e of [`resonant_zeta`]: per_response / (2 sqrt(boundary^2 + 2 per_response
+/// |a_e|)) times the sign of a_e (infinite at a_e = 0 without boundary damping, where the root
+/// has a vertical tangent).
+pub fn resonant_zeta_slope(boundary: f64, per_response: f64, a_e: f64) -> f64 {
+    if !a_e.is_finite() {
+        return 0.0;
+    }
+    let root = (boundary * boundary + 2.0 * per_response * a_e.abs()).sqrt();
+    0.5 * per_response / root * a_e.signum()
+}
+
 /// The random form's factor (MODEL.md 11): zeta_s = K X for a sinusoid of amplitude X becomes
 /// zeta_s = 3 sqrt(pi/8) K sigma = 1.880 K sigma for Gaussian narrow-band response of standard
 /// deviation sigma (E|u|^3 / E[u^2] = 2 sqrt(2/pi) sigma against (8/(3 pi)) U).
@@ -151,6 +162,15 @@ pub const RANDOM_SCREENS: f64 = 1.879_971_205_973_250_3;
 pub fn random_zeta(boundary: f64, per_response: f64, sigma: f64) -> f64 {
     let sigma = if sigma.is_finite() { sigma.abs() } else { 0.0 };
     boundary + RANDOM_SCREENS * per_response * sigma
+}
+
+/// d zeta / d sigma of [`random_zeta`].
+pub fn random_zeta_slope(per_response: f64, sigma: f64) -> f64 {
+    if sigma.is_finite() {
+        RANDOM_SCREENS * per_response * sigma.signum()
+    } else {
+        0.0
+    }
 }
 
 #[cfg(test)]

@@ -13,6 +13,15 @@ use tld_fmu::fmi::vars::vr;
 pub(crate) const LIBRARY: &str = "tld_fmu";
 
 impl Instance {
+    /// Model Exchange: initialisation entered and left, the first event iteration, into
+    /// continuous-time mode.
+    pub fn start_continuous_time(&self) {
+        assert_eq!(self.enter(), OK);
+        assert_eq!(self.exit(), OK, "{:?}", self.logs());
+        assert_eq!(self.new_discrete_states().0, OK);
+        assert_eq!(self.enter_continuous_time_mode(), OK);
+    }
+
     /// setup, enter, exit: ready to step.
     pub fn initialise(&self) {
         assert_eq!(self.setup(), OK);
@@ -112,4 +121,60 @@ pub fn vr_of(name: &str) -> u32 {
         .find(|v| v.name == name)
         .map(|v| v.vr)
         .unwrap_or_else(|| panic!("no variable {name}"))
+}
+
+/// The first continuous states, those S^2 uses (every oscillator model the first four).
+pub const S2_NAMES: [&str; 6] = [
+    "slosh.x",
+    "slosh.v",
+    "energy.input",
+    "energy.dissipated",
+    "impact.z",
+    "impact.v",
+];
+
+/// J's column `j` against the central differences of the unknowns' values `up` and `down` at
+/// steps +-`h` of one known: every entry within 1e-6 relative (the differences' truncation)
+/// plus their rounding; a failure names the entry by `entry(i)`. Returns the largest error
+/// relative to its tolerance (<= 1 passes).
+pub fn against_differences(
+    j: &[f64],
+    up: &[f64],
+    down: &[f64],
+    h: f64,
+    entry: impl Fn(usize) -> String,
+) -> f64 {
+    let mut worst: f64 = 0.0;
+    for i in 0..j.len() {
+        let fd = (up[i] - down[i]) / (2.0 * h);
+        let tol = 1e-6 * j[i].abs().max(fd.abs())
+            + 1e3 * f64::EPSILON * (up[i].abs() + down[i].abs()) / h;
+        let err = (j[i] - fd).abs();
+        assert!(
+            err <= tol,
+            "{}: {} by J d, {fd} by differences",
+            entry(i),
+            j[i]
+        );
+        worst = worst.max(err / tol.max(f64::MIN_POSITIVE));
+    }
+    worst
+}
+
+/// The unknowns' values (read by `values`) at the point `p` moved by +`h` and by -`h` in its
+/// coordinate `k` (each point set by `put`): what a central difference needs.
+pub fn values_either_side(
+    p: &[f64],
+    k: usize,
+    h: f64,
+    put: impl Fn(&[f64]),
+    values: impl Fn() -> Vec<f64>,
+) -> (Vec<f64>, Vec<f64>) {
+    let mut q = p.to_vec();
+    q[k] = p[k] + h;
+    put(&q);
+    let up = values();
+    q[k] = p[k] - h;
+    put(&q);
+    (up, values())
 }

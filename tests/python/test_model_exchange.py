@@ -32,10 +32,7 @@ def base_input():
     """Sample times t, samples a (each held until the next sample time) and fmpy's staircase."""
     t = DT * np.arange(int(round(T_END / DT)) + 1)
     a = -W ** 2 * AMP * np.sin(W * t)
-    signal = np.zeros(2 * len(t) - 1, dtype=[("time", np.float64), ("base.a", np.float64)])
-    signal["time"][0::2], signal["base.a"][0::2] = t, a
-    signal["time"][1::2], signal["base.a"][1::2] = t[1:], a[:-1]
-    return t, a, signal
+    return t, a, R.staircase(t, a)
 
 
 # CVode's global error over the 2000 restarts, as a fraction of the peak, at each tolerance
@@ -171,20 +168,28 @@ def test_fmpy_validates_both_fmus_with_model_exchange(fmu_path):
         assert md.numberOfEventIndicators == indicators
 
 
-@pytest.mark.parametrize("rtol", [1e-6, 1e-8])
+# slosh.x of ME against CS under the sampled input, by rtol (see the test's docstring).
+SAMPLED_BOUND = {1e-6: 0.25, 1e-8: 5e-2}
+
+
+@pytest.mark.parametrize("rtol", sorted(SAMPLED_BOUND))
 def test_defaults_run_in_me_under_a_sampled_input(fmu_path, rtol):
     """What a host does first: the default parameters (amplitude = Tracked) and an input sampled
-    every 10 ms (not a staircase: fmpy sets it at its output points), through fmpy's CVode. The
-    run must go through (no refusal, no Discard of a solver's trial state) and track the 4 mm
-    excitation; the motion follows Co-Simulation's at 10 ms, whose estimator filters samples
-    held over each step (first order in the step: tests/model_exchange_tracked.rs measures
-    slosh.x 5.5e-3 at 2 ms, 2.7e-3 at 1 ms against ME) and whose held input differs from what
-    CVode sees by up to one sample: measured 1.5e-2 and 2.6e-2 of the peak at rtol 1e-6 and 1e-8, so a 5e-2 bound
-    (the estimators' and the input's difference, not the model's; accuracy against references
-    is the staircase tests' and model_exchange_tracked.rs's job). rtol 1e-6 and 1e-8: at 1e-10
-    fmpy's CVode stops at t = 0.006 s (mxstep; the estimator's moments start at 0, and a trial
-    state that puts one at or below 0 switches the estimate to the prior: docs/MODEL_EXCHANGE.md,
-    Left)."""
+    every 10 ms (not a staircase: fmpy sets it at its output points and, interpolated, in its
+    root function at every internal CVode step), through fmpy's CVode. The run must go through
+    (no refusal, no Discard of a solver's trial state) and track the 4 mm excitation; the motion
+    follows Co-Simulation's at 10 ms, whose estimator filters samples held over each step (first
+    order in the step: tests/model_exchange_tracked.rs measures slosh.x 5.5e-3 at 2 ms, 2.7e-3
+    at 1 ms against ME) and whose held input differs from what CVode sees (the input at CVode's
+    own step ends, which the tolerance sets): measured 1.0e-1 and 2.4e-2 of the peak at rtol
+    1e-6 and 1e-8, so bounds 0.25 and 5e-2 (the estimators' and the input's difference, not the
+    model's; accuracy against references is the staircase tests', test_me_tracked.py's and
+    model_exchange_tracked.rs's job). The bound at 1e-6 was 5e-2 and is loosened: amplitude =
+    Fixed under the same input measures 1.6e-1 (long steps at 1e-6, the input seen late);
+    Tracked measured 1.5e-2 only while its rebuilt velocity's nominal was 25 times smaller than
+    slosh.v's, which forced short steps (and stopped CVode at rtol 1e-10:
+    docs/MODEL_EXCHANGE.md). rtol 1e-10 under this input: test_me_tracked.py (20 s of it take
+    2 min)."""
     t = DT * np.arange(int(round(T_END / DT)) + 1)
     signal = np.zeros(len(t), dtype=[("time", np.float64), ("base.a", np.float64)])
     signal["time"], signal["base.a"] = t, -W ** 2 * AMP * np.sin(W * t)
@@ -199,4 +204,4 @@ def test_defaults_run_in_me_under_a_sampled_input(fmu_path, rtol):
     print(f"defaults in ME (CVode {rtol:g}), sampled input: slosh.x vs CS {ex:.1e} of peak, "
           f"A_e.estimate {me['A_e.estimate'][-1] * 1e3:.3f} mm")
     assert abs(me["A_e.estimate"][-1] - AMP) < 0.05 * AMP
-    assert ex < 5e-2
+    assert ex < SAMPLED_BOUND[rtol]

@@ -1,17 +1,20 @@
 //! The damper in Model Exchange: the model's continuous states (see `model::continuous`) with
 //! what the damper adds around them, the energy at the start (counted as input) and the damping
-//! law. The damping ratio is constant in Model Exchange: amplitude = Fixed. The online amplitude
-//! estimate (amplitude = Tracked) is a sampled filter of the host's communication steps, and a
-//! host's solver has none; it is refused with that reason.
+//! law. With amplitude = Tracked the damping ratio is the law's at the estimate of the
+//! estimator's states (`tracked`), and J d carries their change through the estimate and the
+//! law into the damping.
 
 use super::{Damper, per_step};
 use crate::model::continuous::{BANK, Direction, IMPACT_V, IMPACT_Z, STATES, Tangent};
-use crate::model::{AmplitudeSource, Inputs, Output};
+use crate::model::{Inputs, Output};
+use crate::physics::amplitude::TRACKER_CONTINUOUS;
 
 /// What a directional derivative asks for: a state's derivative (in state order) or an output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Unknown {
     Derivative(usize),
+    /// The derivative of the amplitude estimator's state k (amplitude = Tracked; else 0).
+    Tracker(usize),
     Output(Output),
     /// The derivative of a state this model does not have (identically 0).
     Frozen,
@@ -74,8 +77,10 @@ impl Damper {
     }
 
     /// J d: the exact change of each of `unknowns` for the change `d` of the states and inputs
-    /// (amplitude = Fixed, so the damping ratio does not change with them), into `out`. Err, and
-    /// `out` untouched, for a damper not offered in Model Exchange or an unknown out of range.
+    /// (with amplitude = Tracked the estimator's too, which move the estimate and through the
+    /// damping law the damping ratio; `d.zeta` is ignored, the damper sets it), into `out`.
+    /// Err, and `out` untouched, for a damper not offered in Model Exchange or an unknown out of
+    /// range.
     pub fn directional_derivatives(
         &self,
         inputs: &Inputs,
@@ -84,14 +89,11 @@ impl Damper {
         out: &mut [f64],
     ) -> Result<(), String> {
         self.offers_model_exchange()?;
-        if let AmplitudeSource::Tracked { .. } = self.common.amplitude {
-            return Err(
-                "amplitude = Tracked has no directional derivatives (the damping ratio's \
-                 dependence on the estimator's states is not differentiated); difference \
-                 fmi2GetDerivatives, or set amplitude = Fixed"
-                    .into(),
-            );
-        }
+        let tracked = self.tracker_tangent(inputs, d);
+        let d = &Direction {
+            zeta: tracked.zeta,
+            ..*d
+        };
         let t = self.model.continuous_tangent(inputs.a, d)?;
         let mut values = Vec::with_capacity(unknowns.len());
         for &unknown in unknowns {
@@ -99,6 +101,14 @@ impl Damper {
                 Unknown::Derivative(k) => *t.derivatives.get(k).ok_or_else(|| {
                     format!("there are {STATES} state derivatives, not {}", k + 1)
                 })?,
+                Unknown::Tracker(k) => *tracked.rates.get(k).ok_or_else(|| {
+                    format!(
+                        "the estimator has {TRACKER_CONTINUOUS} states, not {}",
+                        k + 1
+                    )
+                })?,
+                Unknown::Output(Output::Amplitude) => tracked.estimate,
+                Unknown::Output(Output::Zeta) => tracked.zeta,
                 Unknown::Output(which) => self.output_tangent(which, d, &t)?,
                 Unknown::Frozen => 0.0,
             });
@@ -130,7 +140,8 @@ impl Damper {
             Output::EnergyDissipated => d.states[3],
             Output::EnergyStored => stored,
             Output::ImpactZ => impact_z,
-            // Fixed amplitude and damping; the count of impacts changes at events only.
+            // The amplitude and damping: the estimator's (above); the count of impacts changes at
+            // events only.
             Output::Amplitude | Output::Zeta | Output::Impacts => 0.0,
             Output::SurfaceLeft | Output::SurfaceRight => {
                 if self.model.surface().is_some() {

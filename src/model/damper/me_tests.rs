@@ -172,31 +172,131 @@ fn states_beyond_a_hundred_tank_lengths_are_refused_and_change_nothing() {
     }
 }
 
-/// amplitude = Tracked is offered in Model Exchange (the estimator as states), but not its
-/// directional derivatives: refused with the reason, the output untouched.
+/// amplitude = Tracked: J d carries the change of the estimator's states through the estimate
+/// and the damping law into the damping. Every column (the 24 states, the estimator's 7,
+/// base.a, base.v) of every output, state derivative and estimator derivative against central
+/// differences of the outputs and derivatives themselves, for Linear (3 modes), Nonlinear and
+/// S^2 with its impact mass in flight and resting on a wall, under NSD (Lambda inside its
+/// clamp) and Screens, with the velocity rebuilt and measured (base.v then enters the
+/// estimator's rates). The filters are set mid-way (the estimate neither the prior nor
+/// settled).
 #[test]
-fn a_tracked_amplitude_has_no_directional_derivatives() {
-    let p = params(LINEAR)
-        .with(vr::AMPLITUDE, TRACKED)
-        .with(vr::AMPLITUDE_TAU, 0.0)
-        .with(vr::A_E, 0.005)
-        .with(vr::SLOSH_X0, 0.0);
-    let d = damper(&p);
-    assert_eq!(d.offers_model_exchange(), Ok(()));
-    let mut out = [7.0];
-    let why = d
-        .directional_derivatives(
-            &held(0.0),
-            &Direction::default(),
-            &[Unknown::Derivative(0)],
-            &mut out,
-        )
-        .expect_err("not offered");
-    assert!(
-        why.contains("amplitude = Tracked has no directional derivatives"),
-        "{why}"
-    );
-    assert_eq!(out, [7.0]);
+fn a_tracked_amplitudes_tangent_is_its_change() {
+    use crate::model::shallow_water::continuous::CELL_STATES;
+    use crate::physics::amplitude::TRACKER_CONTINUOUS;
+    const NSD: f64 = 2.0;
+    const SCREENS: f64 = 4.0;
+    let mut cases = 0;
+    let models = [
+        (LINEAR, 3.0, false),
+        (NONLINEAR, 1.0, false),
+        (SLAMMING, 1.0, false),
+        (SLAMMING, 1.0, true),
+    ];
+    for (model, modes, rest) in models {
+        for law in [NSD, SCREENS] {
+            for measured in [false, true] {
+                let p = params(model)
+                    .with(vr::MODES, modes)
+                    .with(vr::AMPLITUDE, TRACKED)
+                    .with(vr::AMPLITUDE_TAU, 0.7)
+                    .with(vr::DAMPING, law)
+                    .with(vr::SCREENS_COUNT, 2.0)
+                    .with(vr::SLAMMING_CLEARANCE, 0.1);
+                let mut d = damper(&p);
+                let inputs = Inputs {
+                    a: -0.6,
+                    v: if measured { 0.03 } else { 0.0 },
+                    ..Inputs::default()
+                };
+                assert_eq!(d.tracker_event(&inputs), measured);
+                let mut s = d.continuous_states();
+                s[..6].copy_from_slice(&[0.02, -0.05, 0.4, 0.1, 0.03, 0.2]);
+                for (k, v) in s[BANK..BANK + 4].iter_mut().enumerate() {
+                    *v = 0.004 * (k as f64 - 1.5);
+                }
+                if rest {
+                    // Pressed onto the wall +d/2 (the base accelerating towards -x), at rest.
+                    (s[IMPACT_Z], s[IMPACT_V]) = (0.05, 0.0);
+                    d.set_continuous_states(&s).expect("takes them");
+                    assert!(matches!(
+                        d.event(&held(-30.0)),
+                        Event::Impact { rests: true, .. }
+                    ));
+                    s = d.continuous_states();
+                }
+                // Mid-way filters of base motion about 3 mm at 5 rad/s (the mean squares of
+                // its velocity and acceleration, 1.1e-4 and 2.8e-3 when settled).
+                let tracker = [0.011, 6e-5, 4e-5, 1.6e-3, 9e-4, 0.55, 0.3];
+                let cells = [0.0; CELL_STATES];
+                d.set_all_continuous_states(&s, &tracker, &cells)
+                    .expect("takes them");
+                let mut dir = Direction::default();
+                for (k, v) in dir.states.iter_mut().enumerate() {
+                    *v = 0.1 + 0.05 * k as f64;
+                }
+                for (k, v) in dir.tracker.iter_mut().enumerate() {
+                    *v = tracker[k] * (0.3 + 0.1 * k as f64);
+                }
+                (dir.a, dir.v) = (0.7, 0.02);
+                let h = 1e-4;
+                let at = |sign: f64| {
+                    let mut m = d.clone();
+                    let mut t = s;
+                    for (v, dv) in t.iter_mut().zip(dir.states) {
+                        *v += sign * h * dv;
+                    }
+                    let tr: [f64; TRACKER_CONTINUOUS] =
+                        std::array::from_fn(|k| tracker[k] + sign * h * dir.tracker[k]);
+                    m.set_all_continuous_states(&t, &tr, &cells).expect("near");
+                    let i = Inputs {
+                        a: inputs.a + sign * h * dir.a,
+                        v: inputs.v + sign * h * dir.v,
+                        ..inputs
+                    };
+                    (m, i)
+                };
+                let ((plus, ip), (minus, im)) = (at(1.0), at(-1.0));
+                let mut unknowns: Vec<Unknown> =
+                    OUTPUTS.iter().map(|&o| Unknown::Output(o)).collect();
+                unknowns.extend((0..STATES).map(Unknown::Derivative));
+                unknowns.extend((0..TRACKER_CONTINUOUS).map(Unknown::Tracker));
+                let mut out = vec![0.0; unknowns.len()];
+                d.directional_derivatives(&inputs, &dir, &unknowns, &mut out)
+                    .expect("offered");
+                let rates = |m: &Damper, i: &Inputs| {
+                    let mut r = [0.0; TRACKER_CONTINUOUS];
+                    m.tracker_derivatives(i, &mut r);
+                    (m.continuous_derivatives(i), r)
+                };
+                let ((dp, rp), (dm, rm)) = (rates(&plus, &ip), rates(&minus, &im));
+                let case = format!("model {model} (rest {rest}), law {law}, measured {measured}");
+                for (u, got) in unknowns.iter().zip(&out) {
+                    let fd = match *u {
+                        Unknown::Output(o) => {
+                            (plus.output(o, &ip) - minus.output(o, &im)) / (2.0 * h)
+                        }
+                        Unknown::Derivative(k) => (dp[k] - dm[k]) / (2.0 * h),
+                        Unknown::Tracker(k) => (rp[k] - rm[k]) / (2.0 * h),
+                        Unknown::Frozen => unreachable!("not among the unknowns"),
+                    };
+                    // The estimate's and the laws' curvature: the differences' error is
+                    // O(h^2) of their second derivatives (seen below 1e-8 relative).
+                    assert!(
+                        (got - fd).abs() <= 1e-6 * (1e-6 + fd.abs()),
+                        "{case}: {u:?}: {got} vs {fd}"
+                    );
+                }
+                // The damping moves: zeta.effective's and A_e.estimate's entries are not 0.
+                for o in [Output::Zeta, Output::Amplitude] {
+                    let k = OUTPUTS.iter().position(|&x| x == o).expect("an output");
+                    assert!(out[k].abs() > 1e-6, "{case}: {o:?} {}", out[k]);
+                }
+                cases += 1;
+            }
+        }
+    }
+    assert_eq!(cases, 16);
 }
 
 /// J d of every output and every derivative against central differences of the outputs and
@@ -260,8 +360,9 @@ fn every_outputs_tangent_is_its_change() {
             let fd = match *u {
                 Unknown::Output(o) => (plus.output(o, &ip) - minus.output(o, &im)) / (2.0 * h),
                 Unknown::Derivative(k) => (dp[k] - dm[k]) / (2.0 * h),
-                // Not asked for here: the bank's frozen states have no differences to compare.
-                Unknown::Frozen => unreachable!("not among the unknowns"),
+                // Not asked for here: the bank's frozen states have no differences to compare;
+                // the estimator's are frozen (amplitude = Fixed).
+                Unknown::Frozen | Unknown::Tracker(_) => unreachable!("not among the unknowns"),
             };
             assert!(
                 (got - fd).abs() <= 1e-7 * (1.0 + fd.abs()),

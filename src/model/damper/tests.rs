@@ -352,7 +352,7 @@ fn tracked_amplitude_read_late_is_exact() {
     assert!(!lazy.damping_reads_amplitude && eager.damping_reads_amplitude);
     let wf = lazy.derived().omega_f;
     let (tau, prior) = (2.0 * std::f64::consts::TAU / wf, 0.005);
-    let mut reference = AmplitudeTracker::new(tau, 0.05 * wf, prior);
+    let mut reference = AmplitudeTracker::new(tau, 0.05 * wf, prior, wf);
     let mut t = 0.0;
     for k in 0..3000 {
         let h = [0.01, 0.004, 0.01, 0.0125][(k / 400) % 4];
@@ -368,7 +368,7 @@ fn tracked_amplitude_read_late_is_exact() {
         };
         lazy.step(t, h, &inputs).expect("step");
         eager.step(t, h, &inputs).expect("step");
-        let mut fresh = AmplitudeTracker::new(tau, 0.05 * wf, prior);
+        let mut fresh = AmplitudeTracker::new(tau, 0.05 * wf, prior, wf);
         fresh.set_state(&reference.state()).expect("a saved state");
         fresh.update(h, inputs.a, inputs.v);
         reference = fresh;

@@ -7,7 +7,18 @@
 
 use super::Damper;
 use crate::model::Inputs;
+use crate::model::continuous::Direction;
 use crate::physics::amplitude::TRACKER_CONTINUOUS;
+
+/// The estimator's part of J d (all 0 with a fixed amplitude).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TrackerTangent {
+    /// Of the estimator's state derivatives.
+    pub rates: [f64; TRACKER_CONTINUOUS],
+    /// Of the estimate (A_e.estimate) and of the damping ratio the law makes of it.
+    pub estimate: f64,
+    pub zeta: f64,
+}
 
 impl Damper {
     /// The estimator's continuous states (0 with a fixed amplitude).
@@ -28,13 +39,35 @@ impl Damper {
             });
     }
 
-    /// Their nominal magnitudes: for base motion of the prior amplitude at the sloshing
-    /// frequency, its velocity, the squares of its velocity and acceleration, and the weight 1.
+    /// Their nominal magnitudes: the rebuilt velocity's is slosh.v's (both integrate base.a,
+    /// so a host's error control sees the same input changes in both: with the prior's
+    /// velocity, 25 times smaller by default, fmpy's CVode needed more steps than its mxstep
+    /// at rtol 1e-10 under an input it sets at every internal step); for base motion of the
+    /// prior amplitude at the sloshing frequency, the squares of its velocity and
+    /// acceleration (the prior's share of the mean squares, PRIOR_WEIGHT of them, stays far
+    /// above the solver's absolute tolerance); the weight 1.
     pub fn tracker_nominals(&self, out: &mut [f64; TRACKER_CONTINUOUS]) {
         let w = self.derived.omega_f;
         let v = (self.amplitude * w).max(f64::MIN_POSITIVE);
         let a = v * w;
-        *out = [v, v * v, v * v, a * a, a * a, 1.0, 1.0];
+        let rebuilt = self.continuous_nominals()[1];
+        *out = [rebuilt, v * v, v * v, a * a, a * a, 1.0, 1.0];
+    }
+
+    /// J d of the estimator under the inputs now for the direction `d` (its states', base.a's
+    /// and base.v's changes): of its rates, of the estimate (by its gradient) and of the
+    /// damping ratio (the law's slope at the estimate times that).
+    pub fn tracker_tangent(&self, inputs: &Inputs, d: &Direction) -> TrackerTangent {
+        let Some(t) = &self.tracker else {
+            return TrackerTangent::default();
+        };
+        let (estimate, gradient) = t.continuous_estimate();
+        let d_estimate: f64 = gradient.iter().zip(&d.tracker).map(|(g, s)| g * s).sum();
+        TrackerTangent {
+            rates: t.rates_tangent(inputs.a, inputs.v, &d.tracker, d.a, d.v),
+            estimate: d_estimate,
+            zeta: self.common.zeta_slope(estimate) * d_estimate,
+        }
     }
 
     /// Whether the inputs now switch the estimator's velocity source (an event).

@@ -66,8 +66,9 @@ impl Linear {
     }
 
     /// J d of the higher modes under base acceleration `a`, for the changes `bank` of their
-    /// (x, v) pairs and `da` of the base acceleration.
-    pub fn bank_tangent(&self, a: f64, bank: &[f64], da: f64) -> BankTangent {
+    /// (x, v) pairs, `da` of the base acceleration and `dzeta` of the damping ratio (the
+    /// modes share it).
+    pub fn bank_tangent(&self, a: f64, bank: &[f64], da: f64, dzeta: f64) -> BankTangent {
         let mut t = BankTangent::default();
         for (m, pair) in self.modes.iter().skip(1).zip(bank.chunks_exact(2)) {
             let o = m.oscillator();
@@ -75,6 +76,7 @@ impl Linear {
                 dx: pair[0],
                 dv: pair[1],
                 da,
+                dzeta,
             };
             let rate = |which| o.rate_tangent(which, a, change).unwrap_or(0.0);
             t.derivatives.extend([rate(Output::X), rate(Output::V)]);

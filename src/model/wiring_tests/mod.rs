@@ -263,7 +263,7 @@ fn linear_run(modes: u32, tanks: u32, tracking: Option<Tracking>) {
         } else {
             2.0 * 2.0 * PI / w1
         };
-        crate::physics::amplitude::AmplitudeTracker::new(tau, 0.05 * w1, a_e)
+        crate::physics::amplitude::AmplitudeTracker::new(tau, 0.05 * w1, a_e, w1)
     });
     let measured = tracking.is_some_and(|t| t.measured);
     let mut amplitude = a_e;
