@@ -15,6 +15,13 @@
  * state left as it was, and errors go to the host's logger.
  *
  * Build: gcc -O2 -shared -fPIC -o tld_c.so tld_c.c -lm   (bench/python/workprec/cfmu.py)
+ *
+ * With -DTLD_C_ENERGIES it also does what TLD.fmu must and this FMU otherwise leaves out: the
+ * outputs energy.input and energy.dissipated, the integrals of the base's work -a_b x' and of
+ * the dissipation c x'^2 per unit sloshing mass, integrated by the same method as x and v (two
+ * more components of each stage, not error-controlled), so that a host can read them at any
+ * communication point (bench/python/ab_settings.py times both builds).
+ *
  * Parameters it does not model (NSD, amplitude, lambda, ...) are accepted and ignored; the
  * enumerations it does not implement (model other than Nonlinear, damping other than Constant,
  * other solvers) are refused at fmi2ExitInitializationMode. */
@@ -46,7 +53,7 @@ enum {
     VR_MODEL = 6, VR_ETA = 8, VR_PHI = 9, VR_DAMPING = 10, VR_ZETA = 11, VR_X0 = 19,
     VR_V0 = 20, VR_SOLVER = 21, VR_TOLERANCE = 22, VR_FIXED_STEP = 23, VR_MAX_SUBSTEPS = 25,
     VR_OMEGA_F = 40, VR_MASS_SLOSH = 42, VR_MASS_INACTIVE = 43, VR_BASE_A = 50, VR_FORCE = 60,
-    VR_X = 63, VR_V = 64
+    VR_X = 63, VR_V = 64, VR_ENERGY_INPUT = 65, VR_ENERGY_DISSIPATED = 66
 };
 enum { MODEL_NONLINEAR = 2, DAMPING_CONSTANT = 1, SOLVER_DP45 = 1, SOLVER_RK4 = 2 };
 
@@ -59,6 +66,9 @@ typedef struct {
     int p_int; /* p = 2 eta - 2 when an integer in [0, 64], else -1 */
     /* state */
     double x, v, a_b, h_carried;
+    /* -DTLD_C_ENERGIES: the work in and the dissipation per unit sloshing mass, and the stored
+     * energy at the start [J] (counted as input, as TLD.fmu does) */
+    double w_in, w_diss, e0;
     int initialised;
     const fmi2CallbackFunctions *cb;
     char name[64];
@@ -88,6 +98,17 @@ static inline double phi_of(const Tld *s, double x) {
 static inline double accel(const Tld *s, double x, double v, double ab) {
     return -ab - s->c * v - phi_of(s, x);
 }
+
+#ifdef TLD_C_ENERGIES
+/* The energy integrands at velocity v: the base's work -a_b v and the dissipation c v^2. */
+#define ENERGY_RATES(k, v) double k##w = -ab * (v), k##d = s->c * (v) * (v)
+/* The stored energy [J]: kinetic plus the potential of Phi, m (v^2/2 + w2 x^2/2 [1 + q|x|^p/eta]). */
+static double stored(const Tld *s, double x, double v) {
+    double ax = fabs(x);
+    double h = s->p_int >= 0 ? ipow(ax, s->p_int) : pow(ax, s->p);
+    return s->m * (0.5 * v * v + 0.5 * s->w2 * x * x * (1.0 + s->q * h / s->eta));
+}
+#endif
 
 fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
                               const fmi2CallbackFunctions *cb, fmi2Boolean visible,
@@ -140,6 +161,10 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     s->x = s->x0;
     s->v = s->v0;
     s->h_carried = 0.0;
+#ifdef TLD_C_ENERGIES
+    s->w_in = s->w_diss = 0.0;
+    s->e0 = stored(s, s->x, s->v);
+#endif
     s->initialised = 1;
     return fmi2OK;
 }
@@ -216,6 +241,10 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
         case VR_MASS_SLOSH: value[i] = s->m; break;
         case VR_OMEGA_F: value[i] = s->omega; break;
         case VR_BASE_A: value[i] = s->a_b; break;
+#ifdef TLD_C_ENERGIES
+        case VR_ENERGY_INPUT: value[i] = s->e0 + s->m * s->w_in; break;
+        case VR_ENERGY_DISSIPATED: value[i] = s->m * s->w_diss; break;
+#endif
         default: say(s, fmi2Error, "fmi2GetReal: unknown value reference"); return fmi2Error;
         }
     }
@@ -234,13 +263,18 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     return n ? fmi2Error : fmi2OK;
 }
 
-/* RK4 with n equal substeps over dt; 0 on success. */
-static int rk4(const Tld *s, double dt, double *px, double *pv) {
+/* RK4 with n equal substeps over dt; 0 on success. pe: the energy integrals (-DTLD_C_ENERGIES). */
+static int rk4(const Tld *s, double dt, double *px, double *pv, double *pe) {
     double q = dt / s->fixed_step * (1.0 - 1e-12);
     if (!(q <= s->max_substeps)) return -1;
     int n = (int)q;
     if (n < q || n == 0) n++;
     double h = dt / n, x = *px, v = *pv, ab = s->a_b;
+#ifdef TLD_C_ENERGIES
+    double w = pe[0], d = pe[1];
+#else
+    (void)pe;
+#endif
     for (int i = 0; i < n; i++) {
         double k1x = v, k1v = accel(s, x, v, ab);
         double x2 = x + 0.5 * h * k1x, v2 = v + 0.5 * h * k1v;
@@ -249,16 +283,25 @@ static int rk4(const Tld *s, double dt, double *px, double *pv) {
         double k3x = v3, k3v = accel(s, x3, v3, ab);
         double x4 = x + h * k3x, v4 = v + h * k3v;
         double k4x = v4, k4v = accel(s, x4, v4, ab);
+#ifdef TLD_C_ENERGIES
+        ENERGY_RATES(k1, v); ENERGY_RATES(k2, v2); ENERGY_RATES(k3, v3); ENERGY_RATES(k4, v4);
+        w += h / 6.0 * (k1w + 2.0 * (k2w + k3w) + k4w);
+        d += h / 6.0 * (k1d + 2.0 * (k2d + k3d) + k4d);
+#endif
         x += h / 6.0 * (k1x + 2.0 * (k2x + k3x) + k4x);
         v += h / 6.0 * (k1v + 2.0 * (k2v + k3v) + k4v);
     }
     *px = x;
     *pv = v;
+#ifdef TLD_C_ENERGIES
+    pe[0] = w;
+    pe[1] = d;
+#endif
     return 0;
 }
 
 /* Dormand & Prince (1980) 5(4), error per step against the mixed scales; 0 on success. */
-static int dp45(Tld *s, double dt, double *px, double *pv) {
+static int dp45(Tld *s, double dt, double *px, double *pv, double *pe) {
     static const double a21 = 1.0 / 5.0, a31 = 3.0 / 40.0, a32 = 9.0 / 40.0,
         a41 = 44.0 / 45.0, a42 = -56.0 / 15.0, a43 = 32.0 / 9.0, a51 = 19372.0 / 6561.0,
         a52 = -25360.0 / 2187.0, a53 = 64448.0 / 6561.0, a54 = -212.0 / 729.0,
@@ -267,6 +310,11 @@ static int dp45(Tld *s, double dt, double *px, double *pv) {
         b5 = -2187.0 / 6784.0, b6 = 11.0 / 84.0, e1 = 71.0 / 57600.0, e3 = -71.0 / 16695.0,
         e4 = 71.0 / 1920.0, e5 = -17253.0 / 339200.0, e6 = 22.0 / 525.0, e7 = -1.0 / 40.0;
     double x = *px, v = *pv, ab = s->a_b, t = 0.0;
+#ifdef TLD_C_ENERGIES
+    double w = pe[0], d = pe[1];
+#else
+    (void)pe;
+#endif
     double h = s->h_carried > 0 ? s->h_carried : fmin(0.5 * pow(s->tol, 0.2) / s->omega, dt);
     double k1x = v, k1v = accel(s, x, v, ab);
     int rejected = 0;
@@ -300,6 +348,13 @@ static int dp45(Tld *s, double dt, double *px, double *pv) {
             double fac = err == 0.0 ? 5.0 : fmin(fmax(0.9 * pow(err, -0.2), 0.2), 5.0);
             if (rejected) fac = fmin(fac, 1.0);
             rejected = 0;
+#ifdef TLD_C_ENERGIES
+            /* the energies' stages: the integrands at the stage velocities (k_i x = v_i) */
+            ENERGY_RATES(q1, k1x); ENERGY_RATES(q3, k3x); ENERGY_RATES(q4, k4x);
+            ENERGY_RATES(q5, k5x); ENERGY_RATES(q6, k6x);
+            w += hs * (b1 * q1w + b3 * q3w + b4 * q4w + b5 * q5w + b6 * q6w);
+            d += hs * (b1 * q1d + b3 * q3d + b4 * q4d + b5 * q5d + b6 * q6d);
+#endif
             x = xn; v = vn; k1x = k7x; k1v = k7v;
             double proposal = hs * fac;
             if (last) {
@@ -317,6 +372,10 @@ static int dp45(Tld *s, double dt, double *px, double *pv) {
     }
     *px = x;
     *pv = v;
+#ifdef TLD_C_ENERGIES
+    pe[0] = w;
+    pe[1] = d;
+#endif
     return 0;
 }
 
@@ -328,7 +387,8 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real dt, fmi2Boolean noSe
         return fmi2Error;
     }
     double x = s->x, v = s->v, carried = s->h_carried;
-    int fail = s->solver == SOLVER_RK4 ? rk4(s, dt, &x, &v) : dp45(s, dt, &x, &v);
+    double e[2] = {s->w_in, s->w_diss};
+    int fail = s->solver == SOLVER_RK4 ? rk4(s, dt, &x, &v, e) : dp45(s, dt, &x, &v, e);
     if (fail || !isfinite(x) || !isfinite(v) || fabs(x) > 100.0 * s->length) {
         s->h_carried = carried; /* all or nothing */
         say(s, fmi2Discard, "fmi2DoStep: the step failed (too many substeps or a runaway); "
@@ -337,5 +397,9 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real dt, fmi2Boolean noSe
     }
     s->x = x;
     s->v = v;
+#ifdef TLD_C_ENERGIES
+    s->w_in = e[0];
+    s->w_diss = e[1];
+#endif
     return fmi2OK;
 }

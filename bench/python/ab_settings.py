@@ -14,7 +14,9 @@ library, or a git revision built as bench/python/ab.py does. --now: default the 
 release library (built first). The value references come from modelDescription/modelDescription.xml.
 The careful C FMU (bench/c/tld_c.c, compiled with gcc -O2) runs in the same rounds as the "now"
 build: RK4 with one substep (the same arithmetic and error as TLD.fmu's) and DormandPrince45 at
-the same tolerances (not the same error: BENCHMARKS.md compares the fronts at equal error).
+the same tolerances (not the same error: BENCHMARKS.md compares the fronts at equal error),
+twice: as it is, and built with -DTLD_C_ENERGIES, where it also integrates energy.input and
+energy.dissipated as TLD.fmu must (two more components of each stage).
 """
 from __future__ import annotations
 
@@ -89,7 +91,8 @@ def c_cases(d: Description):
             ("C_DP45_1e-12", phys + [d.token("solver.tolerance", 1e-12)])]
 
 
-def job(d: Description, lib: Path, tmp: Path, steps: int, c_lib: Path | None = None) -> Path:
+def job(d: Description, lib: Path, tmp: Path, steps: int,
+        c_libs: list[tuple[str, Path]] | None = None) -> Path:
     wf = math.sqrt(math.pi * 9.81 / 0.25 * math.tanh(math.pi * 0.021 / 0.25))
     w, amp, dt = 1.05 * wf, 0.003, 1e-3
     a = -w * w * amp * np.sin(w * dt * np.arange(steps))
@@ -105,10 +108,10 @@ def job(d: Description, lib: Path, tmp: Path, steps: int, c_lib: Path | None = N
     tag = lib.name.replace(".", "_")
     for name, toks in cases(d):
         lines.append(f"run {name} fmu {' '.join(toks)}")
-    if c_lib is not None:
+    for prefix, c_lib in c_libs or []:
         lines.append(f"lib {c_lib}")
         for name, toks in c_cases(d):
-            lines.append(f"run {name} fmu {' '.join(toks)}")
+            lines.append(f"run {prefix}{name} fmu {' '.join(toks)}")
     path = tmp / f"{tag}.job"
     path.write_text("\n".join(lines) + "\n")
     return path
@@ -130,14 +133,18 @@ def main(argv=None):
     tmp = Path(tempfile.mkdtemp(prefix="tld_ab_settings_"))
     (tmp / "base").mkdir()
     (tmp / "now").mkdir()
-    c_lib = tmp / "tld_c.so"
-    subprocess.run(["gcc", "-O2", "-shared", "-fPIC", "-o", str(c_lib),
-                    str(REPO / "bench" / "c" / "tld_c.c"), "-lm"], check=True)
+    # the C FMU as it is, and with the energies TLD.fmu integrates ("E" before its cases)
+    c_libs = []
+    for prefix, flags in (("", []), ("E", ["-DTLD_C_ENERGIES"])):
+        c_lib = tmp / f"tld_c{prefix}.so"
+        subprocess.run(["gcc", "-O2", *flags, "-shared", "-fPIC", "-o", str(c_lib),
+                        str(REPO / "bench" / "c" / "tld_c.c"), "-lm"], check=True)
+        c_libs.append((prefix, c_lib))
     # the C FMU runs in the "now" job: timed in the same rounds
     jobs = {"base": job(d, base, tmp / "base", args.steps),
-            "now": job(d, now, tmp / "now", args.steps, c_lib)}
+            "now": job(d, now, tmp / "now", args.steps, c_libs)}
     names = [n for n, _ in cases(d)]
-    c_names = [n for n, _ in c_cases(d)]
+    c_names = [p + n for p, _ in c_libs for n, _ in c_cases(d)]
     times = {k: {n: [] for n in names + c_names} for k in jobs}
     for _ in tqdm(range(args.rounds), desc="A/B rounds"):
         for k in jobs:
@@ -166,10 +173,13 @@ def main(argv=None):
              ("defaults_Fixed", "C_DP45_1e-10", "DormandPrince45 at 1e-10 (TLD.fmu's default)"),
              ("defaults", "C_DP45_1e-10", "TLD.fmu's defaults (Tracked) against the C FMU's DP45 at 1e-10"),
              ("tight_Fixed", "C_DP45_1e-12", "DormandPrince45 at 1e-12")]
-    lines += ["", "The careful C FMU (bench/c/tld_c.c, gcc -O2) in the same rounds:", "",
-              "| case | TLD.fmu now ns/step | C FMU ns/step | TLD.fmu / C |", "|---|---|---|---|"]
+    lines += ["", "The careful C FMU (bench/c/tld_c.c, gcc -O2) in the same rounds, as it is and "
+              "with the energies TLD.fmu integrates (-DTLD_C_ENERGIES):", "",
+              "| case | TLD.fmu now ns/step | C FMU ns/step | TLD.fmu / C | C FMU with energies "
+              "ns/step | TLD.fmu / C with energies |", "|---|---|---|---|---|---|"]
     for a, b, what in pairs:
-        lines.append(f"| {what} | {c[a]:.1f} | {c[b]:.1f} | {c[a] / c[b]:.2f} |")
+        lines.append(f"| {what} | {c[a]:.1f} | {c[b]:.1f} | {c[a] / c[b]:.2f} | "
+                     f"{c['E' + b]:.1f} | {c[a] / c['E' + b]:.2f} |")
     lines.append("")
     for k in jobs:
         for n in ("defaults", "RK4_n1", "tight"):

@@ -3,12 +3,11 @@
 //! energy at the start, and the frame of the saved state.
 
 use super::{
-    AmplitudeSource, AnyModel, Common, Derived, Inputs, Interval, Observable, Output, Parameters,
-    Start, StepError, choice,
+    AmplitudeSource, AnyModel, Common, Derived, Inputs, Observable, Output, Parameters, Start,
+    StepError, choice,
 };
 use crate::description::vr;
 use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
-use crate::physics::base::BaseAcceleration;
 use crate::solver::SolveStats;
 
 /// Numbers of a saved state after the model's own: amplitude, mean force (flag and value),
@@ -153,19 +152,11 @@ impl Damper {
     fn advance(&mut self, zeta: f64, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
         // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
         // input, and (t + h) - t is not h in floating point.
-        let step = Interval {
-            t,
-            h,
-            zeta,
-            base: BaseAcceleration {
-                t0: 0.0,
-                a: [inputs.a, inputs.a_derivatives[0], inputs.a_derivatives[1]],
-            },
-            limit: 100.0 * self.common.tank.length,
-        };
+        let a = [inputs.a, inputs.a_derivatives[0], inputs.a_derivatives[1]];
+        let limit = 100.0 * self.common.tank.length;
         // 1/h is ready long before the step's impulse is.
         let inv_h = 1.0 / h;
-        let stepped = self.model.step(&step)?;
+        let stepped = self.model.step(t, h, zeta, a, limit)?;
         self.per_step = [stepped.force, stepped.sloshing.0, stepped.sloshing.1];
         // 1/h overflows for a subnormal h (and 0 x inf is NaN): over so short a step the mean
         // force is the force.

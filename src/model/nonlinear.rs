@@ -269,6 +269,37 @@ pub trait Shortcut {
     ) -> Option<Result<[f64; state::DIM], StepError>>;
 }
 
+/// [`Shortcut::step`] over the interval of these parts, out of line: the interval is made in
+/// memory only here. Made in the step, its stores (ten) were paid on every step of every
+/// nonlinear model, and a step's stores, not its instructions, are what its time follows at RK4
+/// one substep (docs/ARCHITECTURE.md, *Costs*).
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn take_shortcut(
+    shortcut: &mut dyn Shortcut,
+    tld: &NonlinearTld,
+    y: &[f64; state::DIM],
+    t: f64,
+    h: f64,
+    zeta: f64,
+    a0: f64,
+    a1: f64,
+    a2: f64,
+    limit: f64,
+) -> Option<Result<[f64; state::DIM], StepError>> {
+    let step = Interval {
+        t,
+        h,
+        zeta,
+        base: BaseAcceleration {
+            t0: 0.0,
+            a: [a0, a1, a2],
+        },
+        limit,
+    };
+    shortcut.step(tld, y, &step)
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Nonlinear {
     pub(super) tld: NonlinearTld,
@@ -300,25 +331,22 @@ impl Nonlinear {
         limit: f64,
         shortcut: Option<&mut dyn Shortcut>,
     ) -> Result<Stepped, StepError> {
-        let step = &Interval {
-            t,
-            h,
-            zeta,
-            base: BaseAcceleration {
-                t0: 0.0,
-                a: [a0, a1, a2],
-            },
-            limit,
+        let base = BaseAcceleration {
+            t0: 0.0,
+            a: [a0, a1, a2],
         };
         // The model takes this step's damping and input in place (field by field: a whole-struct
         // copy here stalls on store forwarding) and gets its previous ones back if the step fails.
-        let base = &step.base;
         let previous = (self.tld.c, self.tld.base);
-        self.tld.c = 2.0 * step.zeta * self.omega_f;
+        self.tld.c = 2.0 * zeta * self.omega_f;
         self.tld.base.t0 = 0.0;
         self.tld.base.a = base.a;
         let v0 = self.y[state::V];
-        let outcome = match shortcut.and_then(|s| s.step(&self.tld, &self.y, step)) {
+        let taken = match shortcut {
+            Some(s) => take_shortcut(s, &self.tld, &self.y, t, h, zeta, a0, a1, a2, limit),
+            None => None,
+        };
+        let outcome = match taken {
             Some(next) => next.map(|next| {
                 self.y = next;
                 let stats = SolveStats {

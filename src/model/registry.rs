@@ -3,6 +3,7 @@
 
 use super::{Common, Interval, Model, Observable, Output, Parameters, Start, StepError, Stepped};
 use crate::description::ModelKindItem;
+use crate::physics::base::BaseAcceleration;
 
 macro_rules! registry {
     ($( $item:ident => $variant:ident($model:ty) ),* $(,)?) => {
@@ -40,9 +41,29 @@ macro_rules! registry {
                 match self { $( AnyModel::$variant(m) => m.sloshing_mass(), )* }
             }
 
+            /// [`Model::step`] over the interval of these parts. Each model's arm makes its own
+            /// [`Interval`]: one made before the match would be stored to memory for the models
+            /// that take it by reference, and read back by those whose step is inlined (the
+            /// nonlinear ones take it in registers).
             #[inline(always)]
-            pub fn step(&mut self, step: &Interval) -> Result<Stepped, StepError> {
-                match self { $( AnyModel::$variant(m) => m.step(step), )* }
+            #[allow(clippy::too_many_arguments)]
+            pub fn step(
+                &mut self,
+                t: f64,
+                h: f64,
+                zeta: f64,
+                a: [f64; 3],
+                limit: f64,
+            ) -> Result<Stepped, StepError> {
+                match self {
+                    $( AnyModel::$variant(m) => m.step(&Interval {
+                        t,
+                        h,
+                        zeta,
+                        base: BaseAcceleration { t0: 0.0, a },
+                        limit,
+                    }), )*
+                }
             }
 
             #[inline(always)]

@@ -20,11 +20,18 @@ impl BaseAcceleration {
     pub fn at(&self, t: f64) -> f64 {
         // Held input, the usual case, by a predictable branch: no polynomial on the path of
         // every stage (the value is the same: a0 + s (0 + 0.5 s 0) = a0 for finite s).
-        if self.a[1] == 0.0 && self.a[2] == 0.0 {
-            return self.a[0];
+        if let Some(a0) = self.held_value() {
+            return a0;
         }
         let s = t - self.t0;
         self.a[0] + s * (self.a[1] + 0.5 * s * self.a[2])
+    }
+
+    /// The value of a held input (a1 = a2 = 0), which [`BaseAcceleration::at`] gives at every
+    /// time; None for any other.
+    #[inline(always)]
+    pub fn held_value(&self) -> Option<f64> {
+        (self.a[1] == 0.0 && self.a[2] == 0.0).then_some(self.a[0])
     }
 
     /// Integral of a from t0 to t0 + h.

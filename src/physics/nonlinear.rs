@@ -43,17 +43,17 @@ impl NonlinearTld {
 }
 
 impl NonlinearTld {
-    /// The right-hand side with the exponent `e`, which must be of the law's kind.
+    /// The right-hand side with the exponent `e`, which must be of the law's kind, and the base
+    /// acceleration `a_b` at the time of the evaluation.
     #[inline(always)]
     fn eval_with<E: Exponent>(
         &self,
         e: E,
-        t: f64,
+        a_b: f64,
         y: &[f64; state::DIM],
         dy: &mut [f64; state::DIM],
     ) {
         let (x, v) = (y[state::X], y[state::V]);
-        let a_b = self.base.at(t);
         dy[state::X] = v;
         // The restoring force last: it ends the longest chain (x to Phi), so one subtraction
         // follows it, not two.
@@ -74,12 +74,11 @@ impl NonlinearTld {
     fn remainder_with<E: Exponent>(
         &self,
         e: E,
-        t: f64,
+        a_b: f64,
         y: &[f64; state::DIM],
         dy: &mut [f64; state::DIM],
     ) {
         let (x, v) = (y[state::X], y[state::V]);
-        let a_b = self.base.at(t);
         dy[state::X] = 0.0;
         dy[state::V] = -a_b - self.stiffness.hardening_force_with(e, x);
         self.quadratures(a_b, v, dy);
@@ -98,9 +97,11 @@ impl NonlinearTld {
         [[cm1 + sigma * sn, sn], [-w2 * sn, cm1 - sigma * sn]]
     }
 
-    /// Run `job` on this model as a right-hand side compiled for its kind of exponent: the
-    /// same values as the model itself, without a dispatch per evaluation. Inlined into the
-    /// caller: behind a call, the integrator's state would pass through memory both ways.
+    /// Run `job` on this model as a right-hand side compiled for its kind of exponent and
+    /// for a held input or not: the same values as the model itself, without a dispatch per
+    /// evaluation (a held input, the usual case, then costs no test and no polynomial in any
+    /// stage). Inlined into the caller: behind a call, the integrator's state would pass
+    /// through memory both ways.
     #[inline(always)]
     pub fn with_exponent<J: RhsJob>(&self, job: J) -> J::Output {
         struct Compiled<'a, J> {
@@ -111,10 +112,19 @@ impl NonlinearTld {
             type Output = J::Output;
             #[inline(always)]
             fn run<E: Exponent>(self, exponent: E) -> J::Output {
-                self.job.run(&Fixed {
-                    model: self.model,
-                    exponent,
-                })
+                let model = self.model;
+                match model.base.held_value() {
+                    Some(a0) => self.job.run(&Fixed {
+                        model,
+                        exponent,
+                        input: Held(a0),
+                    }),
+                    None => self.job.run(&Fixed {
+                        model,
+                        exponent,
+                        input: Polynomial,
+                    }),
+                }
             }
         }
         self.stiffness.power.dispatch(Compiled { model: self, job })
@@ -133,7 +143,7 @@ pub trait CompiledTld: OscillatorSplit<{ state::DIM }> {
     fn tank_force(&self, x: f64, v: f64) -> f64;
 }
 
-impl<E: Exponent> CompiledTld for Fixed<'_, E> {
+impl<E: Exponent, B: Input> CompiledTld for Fixed<'_, E, B> {
     #[inline(always)]
     fn tank_force(&self, x: f64, v: f64) -> f64 {
         self.model.c * v + self.model.stiffness.force_with(self.exponent, x)
@@ -147,16 +157,45 @@ impl CompiledTld for NonlinearTld {
     }
 }
 
-/// The model with its kind of exponent fixed at compile time.
-struct Fixed<'a, E> {
-    model: &'a NonlinearTld,
-    exponent: E,
+/// How a compiled right-hand side reads the base acceleration at time t.
+trait Input: Copy {
+    fn at(self, base: &BaseAcceleration, t: f64) -> f64;
 }
 
-impl<E: Exponent> Rhs<{ state::DIM }> for Fixed<'_, E> {
+/// A held input, its value known: [`BaseAcceleration::at`]'s at every time.
+#[derive(Clone, Copy)]
+struct Held(f64);
+
+/// Any input: its polynomial.
+#[derive(Clone, Copy)]
+struct Polynomial;
+
+impl Input for Held {
+    #[inline(always)]
+    fn at(self, _: &BaseAcceleration, _: f64) -> f64 {
+        self.0
+    }
+}
+
+impl Input for Polynomial {
+    #[inline(always)]
+    fn at(self, base: &BaseAcceleration, t: f64) -> f64 {
+        base.at(t)
+    }
+}
+
+/// The model with its kind of exponent and of input fixed at compile time.
+struct Fixed<'a, E, B> {
+    model: &'a NonlinearTld,
+    exponent: E,
+    input: B,
+}
+
+impl<E: Exponent, B: Input> Rhs<{ state::DIM }> for Fixed<'_, E, B> {
     #[inline]
     fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
-        self.model.eval_with(self.exponent, t, y, dy);
+        let a_b = self.input.at(&self.model.base, t);
+        self.model.eval_with(self.exponent, a_b, y, dy);
     }
 
     fn jacobian(&self, t: f64, y: &[f64; state::DIM], jac: &mut [[f64; state::DIM]; state::DIM]) {
@@ -168,7 +207,7 @@ impl<E: Exponent> Rhs<{ state::DIM }> for Fixed<'_, E> {
     }
 }
 
-impl<E: Exponent> OscillatorSplit<{ state::DIM }> for Fixed<'_, E> {
+impl<E: Exponent, B: Input> OscillatorSplit<{ state::DIM }> for Fixed<'_, E, B> {
     fn oscillator(&self) -> (f64, f64) {
         self.model.oscillator()
     }
@@ -179,7 +218,8 @@ impl<E: Exponent> OscillatorSplit<{ state::DIM }> for Fixed<'_, E> {
 
     #[inline]
     fn remainder(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
-        self.model.remainder_with(self.exponent, t, y, dy);
+        let a_b = self.input.at(&self.model.base, t);
+        self.model.remainder_with(self.exponent, a_b, y, dy);
     }
 }
 
@@ -193,14 +233,14 @@ impl OscillatorSplit<{ state::DIM }> for NonlinearTld {
     }
 
     fn remainder(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
-        self.remainder_with(self.stiffness.power, t, y, dy);
+        self.remainder_with(self.stiffness.power, self.base.at(t), y, dy);
     }
 }
 
 impl Rhs<{ state::DIM }> for NonlinearTld {
     #[inline]
     fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
-        self.eval_with(self.stiffness.power, t, y, dy);
+        self.eval_with(self.stiffness.power, self.base.at(t), y, dy);
     }
 
     fn jacobian(&self, t: f64, y: &[f64; state::DIM], jac: &mut [[f64; state::DIM]; state::DIM]) {
@@ -299,26 +339,33 @@ mod tests {
                 out
             }
         }
-        // One eta per kind of exponent (2 eta - 2 = 0, 1, 2, 3, 4, 8, 3.4), and phi = 0.
+        // One eta per kind of exponent (2 eta - 2 = 0, 1, 2, 3, 4, 8, 3.4), and phi = 0; a
+        // held input (compiled with its value) and the inputs that are not held (their
+        // polynomial), a ramp or a parabola alone among them.
         for (eta, phi) in [(1.0, 1.0), (1.5, 1.0), (2.0, 1.0), (2.5, 0.7), (3.0, 1.0)]
             .into_iter()
             .chain([(5.0, 1.0), (2.7, 1.0), (3.0, 0.0)])
         {
-            let m = NonlinearTld {
-                stiffness: PowerLaw::new(5.6, phi, eta, 0.25),
-                c: 0.3,
-                base: BaseAcceleration {
-                    t0: 0.0,
-                    a: [0.4, 1.0, -2.0],
-                },
-            };
-            let states: Vec<[f64; state::DIM]> = [-0.3, -0.11, -1e-3, 0.0, 2e-4, 0.07, 0.124, 0.4]
-                .iter()
-                .map(|&x| [x, 0.5 - x, 0.1, 0.2])
-                .collect();
-            let compiled = m.with_exponent(Evaluate(states.clone()));
-            let direct = Evaluate(states).run(&m);
-            assert_eq!(compiled, direct, "eta {eta} phi {phi}");
+            for a in [
+                [0.4, 1.0, -2.0],
+                [0.4, 0.0, 0.0],
+                [0.4, 1.0, 0.0],
+                [0.4, 0.0, -2.0],
+            ] {
+                let m = NonlinearTld {
+                    stiffness: PowerLaw::new(5.6, phi, eta, 0.25),
+                    c: 0.3,
+                    base: BaseAcceleration { t0: 0.0, a },
+                };
+                let states: Vec<[f64; state::DIM]> =
+                    [-0.3, -0.11, -1e-3, 0.0, 2e-4, 0.07, 0.124, 0.4]
+                        .iter()
+                        .map(|&x| [x, 0.5 - x, 0.1, 0.2])
+                        .collect();
+                let compiled = m.with_exponent(Evaluate(states.clone()));
+                let direct = Evaluate(states).run(&m);
+                assert_eq!(compiled, direct, "eta {eta} phi {phi} input {a:?}");
+            }
         }
     }
 
