@@ -131,7 +131,7 @@ impl Damper {
             Output::EnergyStored => stored,
             Output::ImpactZ => impact_z,
             // Fixed amplitude and damping; the count of impacts changes at events only.
-            Output::Amplitude | Output::Zeta | Output::Impacts => 0.0,
+            Output::Amplitude | Output::Zeta | Output::Impacts | Output::ImpactImpulse => 0.0,
             Output::SurfaceLeft | Output::SurfaceRight => {
                 if self.model.surface().is_some() {
                     return Err(format!("{which:?} of a model that resolves the surface"));
