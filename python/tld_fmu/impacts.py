@@ -22,17 +22,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-
-def shear_stiffness(k):
-    """Stiffness matrix of a shear building with storey stiffnesses k (storey 1 to the ground)."""
-    n = len(k)
-    K = np.zeros((n, n))
-    for i in range(n):
-        K[i, i] += k[i]
-        if i + 1 < n:
-            K[i, i] += k[i + 1]
-            K[i, i + 1] = K[i + 1, i] = -k[i + 1]
-    return K
+from .building import shear_stiffness  # noqa: F401  (the structure's K, for the callers)
 
 
 def s2_masses(a=0.25, b=0.32, h=0.021, rho=1000.0, g=9.81, tanks=1, Omega=0.9, ratio=0.01):

@@ -78,20 +78,31 @@ class MeFmu:
         shutil.rmtree(self.dir, ignore_errors=True)
 
 
+class Pair:
+    """The two FMUs as one ODE system: the stacked states, the loop closed algebraically."""
+
+    def __init__(self, building: MeFmu, tld: MeFmu):
+        self.building, self.tld, self.nb = building, tld, building.nx
+
+    def close_loop(self, t=None, y=None):
+        """States `y` at `t` into both FMUs (if given), then force -> tld.force and tld.a ->
+        base.a (in that order: TLD's force has no feedthrough)."""
+        if y is not None:
+            self.building.set_states(t, y[:self.nb])
+            self.tld.set_states(t, y[self.nb:])
+        self.building.set("tld.force", self.tld.get("force"))
+        self.tld.set("base.a", self.building.get("tld.a"))
+
+    def rhs(self, t, y):
+        self.close_loop(t, y)
+        return np.concatenate([self.building.derivatives(), self.tld.derivatives()])
+
+
 def coupled(building: MeFmu, tld: MeFmu, t_eval, rtol=1e-10, atol=1e-14):
     """Integrate both FMUs as one system over `t_eval`; returns time, X (roof.x: the one-storey
     building's displacement relative to the ground) and x (slosh.x) at t_eval."""
-    nb = building.nx
-
-    def close_loop(t, y):
-        building.set_states(t, y[:nb])
-        tld.set_states(t, y[nb:])
-        building.set("tld.force", tld.get("force"))
-        tld.set("base.a", building.get("tld.a"))
-
-    def rhs(t, y):
-        close_loop(t, y)
-        return np.concatenate([building.derivatives(), tld.derivatives()])
+    pair = Pair(building, tld)
+    close_loop, rhs = pair.close_loop, pair.rhs
 
     y0 = np.concatenate([building.states(), tld.states()])
     sol = solve_ivp(rhs, (t_eval[0], t_eval[-1]), y0, method="DOP853", t_eval=t_eval,
@@ -162,20 +173,10 @@ def coupled_with_events(building: MeFmu, tld: MeFmu, t_eval, rtol=1e-10, atol=1e
     (`Events.iterate`), restart from the states they give back. `outputs`: names read from
     either FMU at `t_eval`; `on_event(t, before, after)` gets the stacked states around each
     event. Returns {name: array} with "time" and "events" (their times)."""
-    nb = building.nx
+    pair = Pair(building, tld)
+    close_loop, rhs = pair.close_loop, pair.rhs
     events = Events(building, tld, transfer)
     names = {n: (building if n in building.vr else tld) for n in outputs}
-
-    def close_loop(t=None, y=None):
-        if y is not None:
-            building.set_states(t, y[:nb])
-            tld.set_states(t, y[nb:])
-        building.set("tld.force", tld.get("force"))
-        tld.set("base.a", building.get("tld.a"))
-
-    def rhs(t, y):
-        close_loop(t, y)
-        return np.concatenate([building.derivatives(), tld.derivatives()])
 
     def root(k):
         def f(t, y):
