@@ -227,3 +227,43 @@ fn nominals_are_the_static_drift_and_its_velocity() {
         );
     }
 }
+
+/// tld.impulse, a discrete input: refused in continuous-time mode; set in event mode, the
+/// next fmi2NewDiscreteStates makes the damper's floor's velocity jump by the change over its
+/// mass with tld.mass (the other floors and the displacements unchanged, states reported
+/// changed), tld.v.jump reports the jumps so far, and a second call changes nothing.
+#[test]
+fn an_impulse_on_the_damper_floor_jumps_its_velocity_by_the_change_over_its_mass() {
+    let inst = running("me-impulse");
+    assert_eq!(inst.set_states(&some_state()), OK);
+    assert_eq!(inst.set_real(vr::TLD_IMPULSE, 1.0), ERROR);
+    let floor_mass = 168.0 + 0.35; // storey[3].mass (default) + tld.mass
+    let mut expected = some_state();
+    for (k, p) in [(1, 2.5), (2, 2.5 - 4.0)] {
+        let (_, before) = inst.states(N);
+        assert_eq!(inst.enter_event_mode(), OK);
+        assert_eq!(inst.set_real(vr::TLD_IMPULSE, p), OK);
+        let (s, info) = inst.new_discrete_states();
+        assert_eq!(
+            (s, info.valuesOfContinuousStatesChanged),
+            (OK, 1),
+            "event {k}"
+        );
+        let (_, after) = inst.states(N);
+        let change = if k == 1 { 2.5 } else { -4.0 };
+        expected[22] += change / floor_mass;
+        for i in 0..N {
+            assert!(
+                (after[i] - expected[i]).abs() <= 1e-15,
+                "event {k}, state {i}"
+            );
+            if i != 22 {
+                assert_eq!(after[i], before[i], "event {k}, state {i}");
+            }
+        }
+        assert!((inst.real(vr::TLD_V_JUMP) - p / floor_mass).abs() < 1e-16);
+        let (_, again) = inst.new_discrete_states();
+        assert_eq!(again.valuesOfContinuousStatesChanged, 0);
+        assert_eq!(inst.enter_continuous_time_mode(), OK);
+    }
+}

@@ -141,6 +141,17 @@ impl Table {
                     )));
                 }
             }
+            // FMI 2.0 (Model Exchange): a discrete input changes at events only.
+            Causality::Input
+                if phase == Phase::ContinuousTimeMode
+                    && var.variability == Variability::Discrete =>
+            {
+                return Err(refuse(format!(
+                    "{function}: '{}' is a discrete input: set it in event mode \
+                     (fmi2EnterEventMode), then call fmi2NewDiscreteStates",
+                    var.name
+                )));
+            }
             Causality::Input => {}
             _ => {
                 return Err(refuse(format!(

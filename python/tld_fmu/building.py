@@ -16,6 +16,18 @@ from . import fmulog
 from .contract import Contract
 
 
+def shear_stiffness(k):
+    """Stiffness matrix of a shear building with storey stiffnesses k (storey 1 to the ground)."""
+    n = len(k)
+    K = np.zeros((n, n))
+    for i in range(n):
+        K[i, i] += k[i]
+        if i + 1 < n:
+            K[i, i] += k[i + 1]
+            K[i, i + 1] = K[i + 1, i] = -k[i + 1]
+    return K
+
+
 class Building:
     """M X'' + C X' + K X = -M 1 a_g + F, X relative to the ground (floors 0..N-1)."""
 
@@ -23,12 +35,7 @@ class Building:
         m = np.array(masses, float) + (0 if extra_mass is None else np.asarray(extra_mass, float))
         k = np.array(stiffnesses, float)
         n = len(m)
-        K = np.zeros((n, n))
-        for i in range(n):
-            K[i, i] += k[i]
-            if i + 1 < n:
-                K[i, i] += k[i + 1]
-                K[i, i + 1] = K[i + 1, i] = -k[i + 1]
+        K = shear_stiffness(k)
         self.M, self.K, self.n = np.diag(m), K, n
         w2, _ = np_eig(K, m)
         w = np.sqrt(w2[:2] if n > 1 else np.array([w2[0], w2[0]]))

@@ -124,13 +124,14 @@ impl Tld {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fmi::vars::{Causality, index_of};
+    use crate::fmi::vars::{Causality, Variability, index_of};
     use fmi2_slave::calls::{Phase, allow};
     use fmi2_slave::frame::Experiment;
 
     /// The quick case of `check_set` must agree with the full check: every variable in its table
     /// takes any finite value, at its own position, in every phase that allows sets, and refuses a
-    /// non-finite one; and every Real input the full check would take that way is in it.
+    /// non-finite one; and every continuous Real input the full check would take that way is in
+    /// it. A discrete one is not (the full check refuses it in continuous-time mode).
     #[test]
     fn free_real_inputs_are_what_the_full_check_accepts() {
         let mut listed = 0;
@@ -162,6 +163,7 @@ mod tests {
                             assert_eq!(quick, None, "{} = {v}", var.name);
                         }
                     }
+                    None if var.variability == Variability::Discrete => {}
                     None => assert!(
                         !(any_finite && var.causality == Causality::Input),
                         "{} is a Real input the full check takes as any finite value: list it",
@@ -171,5 +173,19 @@ mod tests {
             }
         }
         assert!(listed >= 3, "base.a, base.v and base.x at least");
+        // The discrete Real inputs: never the quick path, refused in continuous-time mode.
+        let discrete: Vec<_> = VARIABLES
+            .iter()
+            .filter(|v| v.causality == Causality::Input && v.variability == Variability::Discrete)
+            .collect();
+        assert!(discrete.iter().any(|v| v.name == "base.v.jump"));
+        for var in discrete {
+            assert_eq!(free_real_input(var.vr), None, "{}", var.name);
+            let refused =
+                TABLE.settable(Phase::ContinuousTimeMode, var.vr, 0.0, VarType::Real, "t");
+            assert!(refused.is_err(), "{}", var.name);
+            let taken = TABLE.settable(Phase::EventMode, var.vr, 0.0, VarType::Real, "t");
+            assert!(taken.is_ok(), "{}", var.name);
+        }
     }
 }

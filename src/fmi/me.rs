@@ -316,11 +316,18 @@ impl Continuous for Tld {
             .sim
             .as_mut()
             .ok_or_else(|| refuse("fmi2NewDiscreteStates: no simulation (not initialised)"))?;
+        // The host's impulse on the structure moved the tank (base.v.jump): first, then the
+        // impacts at the velocities it leaves.
+        let jump = self.values.get(vr::BASE_V_JUMP) - self.v_jump_taken;
+        let jumped = sim
+            .base_velocity_jump(jump)
+            .map_err(|why| refuse(format!("fmi2NewDiscreteStates: base.v.jump: {why}")))?;
+        self.v_jump_taken += jump;
         let event = sim.event(&inputs);
         // amplitude = Tracked: a base.v other than 0 switches the estimator (below).
         let switched = sim.tracker_event(&inputs);
         Ok(EventUpdate {
-            states_changed: matches!(event, Event::Impact { .. }) || switched,
+            states_changed: matches!(event, Event::Impact { .. }) || switched || jumped,
             next_event: None,
         })
     }

@@ -1,7 +1,7 @@
 //! From the variable values the host set to the physics configuration. The only place that
 //! maps FMI variable names onto the simulation's inputs and outputs.
 
-use super::vars::{Causality, VARIABLES, VR_INDEX, VarType, index_of, vr};
+use super::vars::{Causality, VARIABLES, VR_INDEX, VarType, Variability, index_of, vr};
 use crate::model::{Derived, Inputs, Output, Parameters};
 
 /// The variables of the first build with saved-state format version 1 (modelDescription.xml
@@ -211,8 +211,8 @@ pub fn source_of(vr: u32, ty: VarType) -> Source {
     }
 }
 
-/// Where fmi2SetReal stores `vr` with no check but that the value is finite: a Real input
-/// without bounds (what `Instance::check_set` then checks, in every phase that allows sets).
+/// Where fmi2SetReal stores `vr` with no check but that the value is finite: a continuous Real
+/// input without bounds (a discrete one is set in event mode only: the full check; what `Instance::check_set` then checks, in every phase that allows sets).
 /// None for any other variable, which goes through the full check. A table the compiler
 /// builds, read on every step.
 const FREE_REAL_INPUTS: [Option<u8>; VR_INDEX.len()] = {
@@ -222,6 +222,7 @@ const FREE_REAL_INPUTS: [Option<u8>; VR_INDEX.len()] = {
         if let Some(index) = index_of(vr as u32) {
             let var = &VARIABLES[index];
             if matches!(var.causality, Causality::Input)
+                && matches!(var.variability, Variability::Continuous)
                 && matches!(var.ty, VarType::Real)
                 && var.min.is_none()
                 && var.max.is_none()
@@ -260,6 +261,7 @@ pub const fn output_of(vr: u32) -> Option<Output> {
         vr::ZETA_EFFECTIVE => Output::Zeta,
         vr::IMPACT_Z => Output::ImpactZ,
         vr::IMPACTS => Output::Impacts,
+        vr::IMPACT_IMPULSE => Output::ImpactImpulse,
         vr::SURFACE_LEFT => Output::SurfaceLeft,
         vr::SURFACE_RIGHT => Output::SurfaceRight,
         _ => return None,

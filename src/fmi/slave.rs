@@ -31,6 +31,9 @@ pub struct Tld {
     /// Derivatives of base.a (orders 1 and 2) for the next step only.
     pub(super) a_derivatives: [f64; 2],
     pub(super) sim: Option<Damper>,
+    /// The value of the discrete input base.v.jump the model has taken (Model Exchange): an
+    /// event hands the model the change since.
+    pub(super) v_jump_taken: f64,
 }
 
 impl Tld {
@@ -76,6 +79,7 @@ impl Slave for Tld {
             values: Values::start(),
             user_tolerance: false,
             a_derivatives: [0.0; 2],
+            v_jump_taken: 0.0,
             sim: None,
         }
     }
@@ -91,6 +95,8 @@ impl Slave for Tld {
     fn initialise(&mut self, context: &Context) -> Result<Vec<String>, Refusal> {
         let (sim, warnings) = self.build(context)?;
         self.sim = Some(sim);
+        // The start is the host's: only later changes of base.v.jump move the tank.
+        self.v_jump_taken = self.values.get(vr::BASE_V_JUMP);
         Ok(warnings)
     }
 

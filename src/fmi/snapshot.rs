@@ -64,6 +64,8 @@ impl Tld {
             return Err("simulation values in a state before initialisation".into());
         };
         Ok(Tld {
+            // A state is saved between events: the model had taken the input's value.
+            v_jump_taken: values.get(crate::description::vr::BASE_V_JUMP),
             values,
             user_tolerance,
             a_derivatives,

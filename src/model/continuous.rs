@@ -36,6 +36,8 @@ pub const STATES: usize = BANK + 2 * (ME_MODES - 1);
 /// Where S^2's impact mass's position and velocity are among the states.
 pub const IMPACT_Z: usize = 4;
 pub const IMPACT_V: usize = 5;
+/// Where the base's work (energy.input) is among the states.
+pub const ENERGY_INPUT: usize = 2;
 /// Where the bank of higher modes begins.
 pub const BANK: usize = 6;
 

@@ -247,6 +247,7 @@ impl Damper {
             Output::Zeta => self.zeta,
             Output::ImpactZ => observe(Observable::ImpactZ),
             Output::Impacts => observe(Observable::Impacts),
+            Output::ImpactImpulse => observe(Observable::ImpactImpulse),
             Output::SurfaceLeft | Output::SurfaceRight => {
                 let k = usize::from(which == Output::SurfaceRight);
                 self.model

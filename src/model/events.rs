@@ -5,6 +5,7 @@
 //!
 //! [`SloshingSlamming::event`]: super::slamming::SloshingSlamming::event
 
+use super::continuous::{BANK, IMPACT_V};
 use super::registry::AnyModel;
 use super::slamming::Event;
 
@@ -26,5 +27,18 @@ impl AnyModel {
             AnyModel::SloshingSlamming(m) => m.event(a),
             _ => Event::None,
         }
+    }
+
+    /// The continuous states (in [`AnyModel::continuous_states`]' order) that are velocities
+    /// relative to the tank: slosh.v, the flying impact mass's impact.v, the modes' mode[n].v.
+    /// (At rest on a wall the impact mass moves with the tank.)
+    pub fn relative_velocities(&self) -> Vec<usize> {
+        let mut out = vec![1];
+        match self {
+            AnyModel::SloshingSlamming(m) if m.flying() => out.push(IMPACT_V),
+            AnyModel::Linear(m) => out.extend((1..m.modes().len()).map(|k| BANK + 2 * k - 1)),
+            _ => {}
+        }
+        out
     }
 }

@@ -166,7 +166,7 @@ impl Model for Linear {
             Observable::WorkIn => each(|m| m.mass * m.state.work_in),
             Observable::Dissipated => each(|m| m.mass * m.state.dissipated),
             Observable::Stored => each(LinearMode::stored_energy),
-            Observable::ImpactZ | Observable::Impacts => 0.0,
+            Observable::ImpactZ | Observable::Impacts | Observable::ImpactImpulse => 0.0,
         }
     }
 

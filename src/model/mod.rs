@@ -64,6 +64,8 @@ pub enum Output {
     /// S^2: position of the impact mass relative to the tank centre [m], and impacts so far.
     ImpactZ,
     Impacts,
+    /// S^2: momentum the impacts handed to the tanks so far [N s].
+    ImpactImpulse,
     /// Wave height above the still level at the walls x = 0 and x = a [m].
     SurfaceLeft,
     SurfaceRight,
@@ -81,6 +83,8 @@ pub enum Observable {
     /// S^2's impact mass: position [m] and impacts so far (0 for the other models).
     ImpactZ,
     Impacts,
+    /// S^2: momentum the impacts handed to the tanks so far [N s] (0 for the other models).
+    ImpactImpulse,
 }
 
 /// Why a communication step was refused. The model is left as it was before the step.

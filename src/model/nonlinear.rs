@@ -450,7 +450,7 @@ impl Model for Nonlinear {
             Observable::WorkIn => m * y[state::WORK_IN],
             Observable::Dissipated => m * y[state::DISSIPATED],
             Observable::Stored => m * self.tld.stored_energy(y[state::X], y[state::V]),
-            Observable::ImpactZ | Observable::Impacts => 0.0,
+            Observable::ImpactZ | Observable::Impacts | Observable::ImpactImpulse => 0.0,
         }
     }
 

@@ -90,6 +90,7 @@ pub fn rate(which: Output, oscillators: &[Oscillator], free: &[(f64, f64)], a: f
         | Output::Zeta
         | Output::ImpactZ
         | Output::Impacts
+        | Output::ImpactImpulse
         | Output::SurfaceLeft
         | Output::SurfaceRight => 0.0,
     }

@@ -97,6 +97,18 @@ for k, (name, unit) in enumerate([("ground.x", "m/s"), ("ground.v", "m/s2"), ("g
     ders.append(add(f"der({name})", 54 + k, ty="Real", unit=unit, derivative=states[2 * N + k],
                     description=f"time derivative of {name}", **D))
 
+# Added for Model Exchange couplings with impacts (indices above unchanged): TLD.fmu's
+# impact.impulse in, the floor's velocity jump out, both discrete (they change at events).
+tld_impulse = add("tld.impulse", 22, ty="Real", unit="N.s", start=0, causality="input", variability="discrete",
+                  description="Model Exchange: momentum handed to the damper's floor by impulses so far, +x (connect "
+                              "TLD.fmu's impact.impulse); where it changes (set in event mode) the floor's velocities "
+                              "jump by M^-1 times the change (the damper's floor by the change over its mass with "
+                              "tld.mass): an exact momentum transfer; ignored in Co-Simulation (use TLD.fmu's force.mean)")
+tld_v_jump = add("tld.v.jump", 35, ty="Real", unit="m/s", causality="output", variability="discrete",
+                 initial="calculated",
+                 description="Model Exchange: the jumps of the damper's floor's velocity that tld.impulse made so far, "
+                             "+x (connect TLD.fmu's base.v.jump)")
+
 def deps(xs):
     return " ".join(str(x) for x in sorted(xs))
 
@@ -115,6 +127,7 @@ for k in floor_x:
     outputs.append((k, [k], []))
 for i, k in enumerate(floor_a):
     outputs.append((k, [tld_force, floor_f[i]] + floor_x + floor_v, [tld_force, floor_f[i]] + structure))
+outputs.append((tld_v_jump, [tld_impulse], [tld_impulse] + structure))
 outputs.sort()
 initial = sorted(outputs + [(k, None, everything) for k in [w1, w2, alpha, beta]])
 initial += [(ground_v, None, [ground_amp, ground_w]), (ground_hv, None, [ground_amp, ground_w])]
@@ -173,6 +186,7 @@ lines = ['<?xml version="1.0" encoding="UTF-8"?>',
     <Unit name="rad/s"><BaseUnit s="-1" rad="1"/></Unit>
     <Unit name="N"><BaseUnit kg="1" m="1" s="-2"/></Unit>
     <Unit name="N/m"><BaseUnit kg="1" s="-2"/></Unit>
+    <Unit name="N.s"><BaseUnit kg="1" m="1" s="-1"/></Unit>
   </UnitDefinitions>
 
   <LogCategories>

@@ -24,9 +24,22 @@ struct Simulation {
     z: Vec<f64>,
     p: Vec<f64>,
     next: Vec<f64>,
+    /// The value of the discrete input tld.impulse the state has taken (Model Exchange): an
+    /// event applies the change since.
+    impulse_taken: f64,
 }
 
 impl Simulation {
+    /// The change of the state z a unit impulse [N s] on the damper's floor makes: the column
+    /// of B that takes the damper's force (M^-1 on the velocities, nothing on the rest).
+    fn impulse_response(&self) -> Vec<f64> {
+        self.b
+            .column(1 + self.building.damper)
+            .iter()
+            .copied()
+            .collect()
+    }
+
     fn new(building: structure::Building) -> Self {
         let (a, b) = building.state_space();
         let (z, next) = (building.initial_state(), vec![0.0; building.states()]);
@@ -39,6 +52,7 @@ impl Simulation {
             z,
             p,
             next,
+            impulse_taken: 0.0,
         }
     }
 }
@@ -52,6 +66,10 @@ pub struct Building {
 }
 
 mod me;
+
+/// Variables of version 2's first build; those after it (tld.impulse, tld.v.jump) are saved
+/// only when away from their start.
+const VERSION_2_VARIABLES: usize = 187;
 
 /// The value of `vr` in `values` (NaN if it names no variable).
 fn value(values: &[f64], r: u32) -> f64 {
@@ -105,6 +123,11 @@ fn configure(values: &[f64]) -> Result<Simulation, Refusal> {
     design(values)
         .and_then(|d| structure::Building::new(&d))
         .map(Simulation::new)
+        .map(|s| Simulation {
+            // At the start, and in a saved state (taken between events): the input's value.
+            impulse_taken: value(values, vr::TLD_IMPULSE),
+            ..s
+        })
         .map_err(|e| refuse(format!("the parameters are inconsistent: {e}")))
 }
 
@@ -118,6 +141,7 @@ enum Output {
     BaseShear,
     FloorX(usize),
     FloorA(usize),
+    TldVJump,
 }
 
 fn output_of(r: u32) -> Option<Output> {
@@ -128,6 +152,7 @@ fn output_of(r: u32) -> Option<Output> {
         vr::TLD_X => Output::TldX,
         vr::ROOF_X => Output::RoofX,
         vr::BASE_SHEAR => Output::BaseShear,
+        vr::TLD_V_JUMP => Output::TldVJump,
         _ if block(vr::FLOOR_1__X) => Output::FloorX((r - vr::FLOOR_1__X) as usize),
         _ if block(vr::FLOOR_1__A) => Output::FloorA((r - vr::FLOOR_1__A) as usize),
         _ => return None,
@@ -184,6 +209,7 @@ impl Building {
             Output::FloorX(i) => z.get(i).filter(|_| i < n).copied().unwrap_or(0.0),
             Output::FloorA(i) if i < n => accelerations()[i],
             Output::FloorA(_) => 0.0,
+            Output::TldVJump => s.impulse_taken * s.impulse_response()[n + b.damper],
         }
     }
 
@@ -210,7 +236,7 @@ impl Building {
             Output::BaseShear => b.base_shear(&dz[..n], &dz[n..]),
             Output::FloorX(i) if i < n => z[n + i],
             Output::FloorA(i) if i < n => jerk()[i],
-            Output::FloorX(_) | Output::FloorA(_) => 0.0,
+            Output::FloorX(_) | Output::FloorA(_) | Output::TldVJump => 0.0,
         }
     }
 
@@ -363,13 +389,20 @@ impl Slave for Building {
     fn save(&self, out: &mut Vec<u8>) {
         // Model Exchange's locals (states and derivatives) are the simulation's, not values:
         // the saved values are those of the other variables, as before they were added.
+        // Variables added since version 2's first build are listed up to the last one away
+        // from its start, so a run that leaves them alone saves version 2's bytes.
+        let start = Building::new();
+        let mut listed = VARIABLES.len();
+        while listed > VERSION_2_VARIABLES
+            && self.values[listed - 1].to_bits() == start.values[listed - 1].to_bits()
+            && self.derivatives[listed - 1] == [0.0; ORDERS]
+        {
+            listed -= 1;
+        }
         let kept = |k: &usize| VARIABLES[*k].causality != Causality::Local;
-        let values: Vec<f64> = (0..VARIABLES.len())
-            .filter(kept)
-            .map(|k| self.values[k])
-            .collect();
+        let values: Vec<f64> = (0..listed).filter(kept).map(|k| self.values[k]).collect();
         put_f64_list(out, &values);
-        let flat: Vec<f64> = (0..VARIABLES.len())
+        let flat: Vec<f64> = (0..listed)
             .filter(kept)
             .flat_map(|k| self.derivatives[k])
             .collect();
@@ -384,7 +417,9 @@ impl Slave for Building {
         let kept: Vec<usize> = (0..VARIABLES.len())
             .filter(|k| VARIABLES[*k].causality != Causality::Local)
             .collect();
-        if saved.len() != kept.len() || saved_flat.len() != ORDERS * kept.len() {
+        let first = kept.iter().filter(|&&k| k < VERSION_2_VARIABLES).count();
+        if !(first..=kept.len()).contains(&saved.len()) || saved_flat.len() != ORDERS * saved.len()
+        {
             return Err(format!(
                 "{} values and {} derivatives for {} variables",
                 saved.len(),
@@ -397,7 +432,7 @@ impl Slave for Building {
             .map(|v| v.start.unwrap_or(f64::NAN))
             .collect();
         let mut flat = vec![0.0; ORDERS * VARIABLES.len()];
-        for (j, &k) in kept.iter().enumerate() {
+        for (j, &k) in kept.iter().take(saved.len()).enumerate() {
             values[k] = saved[j];
             flat[ORDERS * k..ORDERS * (k + 1)]
                 .copy_from_slice(&saved_flat[ORDERS * j..ORDERS * (j + 1)]);

@@ -140,9 +140,9 @@ impl Damper {
             Output::EnergyDissipated => d.states[3],
             Output::EnergyStored => stored,
             Output::ImpactZ => impact_z,
-            // The amplitude and damping: the estimator's (above); the count of impacts changes at
-            // events only.
-            Output::Amplitude | Output::Zeta | Output::Impacts => 0.0,
+            // The amplitude and damping: the estimator's (above); the count of impacts and their
+            // impulse change at events only.
+            Output::Amplitude | Output::Zeta | Output::Impacts | Output::ImpactImpulse => 0.0,
             Output::SurfaceLeft | Output::SurfaceRight => {
                 if self.model.surface().is_some() {
                     return Err(format!("{which:?} of a model that resolves the surface"));

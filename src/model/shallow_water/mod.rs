@@ -236,7 +236,7 @@ impl Model for ShallowWater {
             // Drag, bores and the bed's friction on dry cells together (MODEL.md 7).
             Observable::Dissipated => self.initial_energy + self.work - stored(),
             Observable::Stored => stored(),
-            Observable::ImpactZ | Observable::Impacts => 0.0,
+            Observable::ImpactZ | Observable::Impacts | Observable::ImpactImpulse => 0.0,
         }
     }
 
@@ -305,7 +305,8 @@ impl Model for ShallowWater {
             | Output::Amplitude
             | Output::Zeta
             | Output::ImpactZ
-            | Output::Impacts => 0.0,
+            | Output::Impacts
+            | Output::ImpactImpulse => 0.0,
         }
     }
 

@@ -40,7 +40,7 @@ pub struct ImpactTangent {
 }
 
 impl SloshingSlamming {
-    fn flying(&self) -> bool {
+    pub(crate) fn flying(&self) -> bool {
         self.state.contact == 0
     }
 

@@ -131,6 +131,7 @@ fn slamming_run(omega_parameter: f64, omega: f64, tanks: f64) {
             a,
             ..Inputs::default()
         };
+        let impulse_before = sim.output(Output::ImpactImpulse, &inputs);
         sim.step(t, h, &inputs).expect("step");
         t += h;
         let (vs0, vi0) = (mode.v, imp.v);
@@ -143,6 +144,16 @@ fn slamming_run(omega_parameter: f64, omega: f64, tanks: f64) {
         }
         let impulse =
             slosh_mass * (-(mode.v - vs0) - a * h) + impact_mass * (-(imp.v - vi0) - a * h);
+        // impact.impulse: in a step without rest on a wall, the impact mass's part of the
+        // step's impulse (force.mean h) is all the impacts'.
+        if kind != 2 {
+            let impacts = sim.output(Output::ImpactImpulse, &inputs) - impulse_before;
+            let expected = impact_mass * (-(imp.v - vi0) - a * h);
+            assert!(
+                (impacts - expected).abs() <= 1e-12 * impact_mass,
+                "{what} at t = {t}: impact.impulse grew by {impacts}, expected {expected}"
+            );
+        }
         let force = slosh_mass * mode.force(zeta);
         let work = slosh_mass * mode.work + impact_mass * imp.work;
         let stored = slosh_mass * mode.stored() + impact_mass * 0.5 * imp.v * imp.v;

@@ -40,6 +40,9 @@ pub struct SlamState {
     pub work_in: f64,
     /// Energy lost in impacts.
     pub dissipated: f64,
+    /// Impulse the impacts gave the tank so far, per unit mass [m/s] (not what the wall gives
+    /// the mass while it rests there).
+    pub impulse: f64,
 }
 
 /// Integrals of the base acceleration from 0: P1(s) = int a, P2(s) = int int a.
@@ -155,6 +158,7 @@ impl Slamming {
         // The tank takes the momentum the water loses; the energy is dissipated.
         st.dissipated += 0.5 * (v_hit * v_hit - v_after * v_after);
         st.v = v_after;
+        st.impulse += v_hit - v_after;
         v_hit - v_after
     }
 

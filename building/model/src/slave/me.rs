@@ -4,7 +4,7 @@
 //! 0), and its derivatives. The same A and B the exact propagator exponentiates: no equation is
 //! written twice.
 
-use fmi2_slave::{Context, Continuous, Refusal, Reply, Status, refuse};
+use fmi2_slave::{Context, Continuous, EventUpdate, Refusal, Reply, Status, refuse};
 use nalgebra::DVector;
 
 use super::{Building, Simulation};
@@ -203,6 +203,30 @@ impl Continuous for Building {
         }
         dv_unknown.copy_from_slice(&out);
         Ok(Status::Ok)
+    }
+
+    /// An impulse on the damper's floor (tld.impulse changed, in event mode): the state jumps
+    /// by B's force column times the change, the velocity jump an impulse makes (its momentum
+    /// goes to the floor whole).
+    fn event_update(&mut self, _: &Context) -> Result<EventUpdate, Refusal> {
+        let input = self.values[index_of(vr::TLD_IMPULSE)
+            .unwrap_or_else(|| unreachable!("the model description declares tld.impulse"))];
+        let s = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| refuse("fmi2NewDiscreteStates: no simulation (not initialised)"))?;
+        let change = input - s.impulse_taken;
+        if change != 0.0 {
+            let jump = s.impulse_response();
+            for (z, j) in s.z.iter_mut().zip(jump) {
+                *z += j * change;
+            }
+            s.impulse_taken = input;
+        }
+        Ok(EventUpdate {
+            states_changed: change != 0.0,
+            next_event: None,
+        })
     }
 
     /// Floors: the static drift of the first storey under 1 g of its own mass, and its velocity
