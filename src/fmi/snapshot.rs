@@ -9,7 +9,9 @@
 //!          start, stop f64
 //!        | derivatives of base.a for the next step (orders 1, 2) f64
 //!        | number of variables u32 | their values f64... (the 54 of the first version-1
-//!          build, then those added since up to the last one away from its start value)
+//!          build, then those added since up to the last one away from its start value; the
+//!          slot of the output impact.impulse holds S^2's impulse per unit impact mass, when
+//!          not 0, beyond the model's pinned part below)
 //!        | number of simulation values u32 (0: not initialised) | the values f64...
 //! simulation values: the model's own part (`Model::save`: its state, then three numbers the
 //!        integrator carries, 0 for the exact models) | the damper's frame (amplitude, mean-force
@@ -24,7 +26,14 @@ use fmi2_slave::frame::{Reader, put_f64, put_f64_list};
 
 use super::params::{Configuration, Values};
 use super::slave::Tld;
+use super::vars::{index_of, vr};
 use crate::model::Damper;
+
+/// The slot of the values that carries [`Damper::extra`]: impact.impulse's.
+const EXTRA_SLOT: usize = match index_of(vr::IMPACT_IMPULSE) {
+    Some(i) => i,
+    None => panic!("impact.impulse is in the model description"),
+};
 
 impl Tld {
     /// TLD's part of the saved state: input derivatives, values, simulation.
@@ -32,7 +41,17 @@ impl Tld {
         for d in self.a_derivatives {
             put_f64(out, d);
         }
-        put_f64_list(out, self.values.to_saved());
+        // S^2's impulse handed over so far (impact.impulse over the impact mass) rides in the
+        // output's own slot of the values, which is otherwise unused (NaN): listed only when
+        // not 0, so every other state keeps the bytes of the earlier builds.
+        match self.sim.as_ref().map_or(0.0, Damper::extra) {
+            0.0 => put_f64_list(out, self.values.to_saved()),
+            extra => {
+                let mut values = self.values.clone();
+                values.set_at(EXTRA_SLOT, extra);
+                put_f64_list(out, values.to_saved());
+            }
+        }
         let simulation = self.sim.as_ref().map(Damper::snapshot).unwrap_or_default();
         put_f64_list(out, &simulation);
     }
@@ -57,7 +76,15 @@ impl Tld {
                 tolerance: context.experiment.tolerance,
                 user_tolerance,
             };
-            Some(Damper::restore(&configuration, &simulation)?)
+            let mut sim = Damper::restore(&configuration, &simulation)?;
+            // Absent, or NaN (the slot's start): 0.
+            let extra = saved_values
+                .get(EXTRA_SLOT)
+                .copied()
+                .filter(|x| !x.is_nan())
+                .unwrap_or(0.0);
+            sim.load_extra(extra)?;
+            Some(sim)
         } else if simulation.is_empty() {
             None
         } else {

@@ -303,6 +303,17 @@ impl Damper {
         out
     }
 
+    /// What the model carries beyond the snapshot's pinned layout ([`Model::extra`]: S^2's
+    /// impact impulse, per unit impact mass); 0 for most.
+    pub fn extra(&self) -> f64 {
+        self.model.extra()
+    }
+
+    /// Take [`Damper::extra`] back after [`Damper::restore`].
+    pub fn load_extra(&mut self, x: f64) -> Result<(), String> {
+        self.model.load_extra(x)
+    }
+
     /// The damper the parameters `p` describe, in the state `snapshot` recorded.
     pub fn restore(p: &dyn Parameters, snapshot: &[f64]) -> Result<Self, String> {
         let (mut damper, _) = Damper::configure(p)?;

@@ -210,6 +210,24 @@ pub trait Model: Sized {
 
     /// Take the state [`Model::save`] wrote (exactly `state_len` finite numbers).
     fn load(&mut self, state: &[f64]) -> Result<(), String>;
+
+    /// A number the model carries beyond [`Model::save`]'s, whose layout tests/golden pins:
+    /// S^2's impulse handed to the tank so far, per unit impact mass (impact.impulse). Saved
+    /// apart; 0 for the models without one.
+    fn extra(&self) -> f64 {
+        0.0
+    }
+
+    /// Take [`Model::extra`] back: a finite number, only 0 for a model without one.
+    fn load_extra(&mut self, x: f64) -> Result<(), String> {
+        if x == 0.0 {
+            Ok(())
+        } else {
+            Err(format!(
+                "an impact impulse ({x}) for a model without impacts"
+            ))
+        }
+    }
 }
 
 /// Refuse a step whose sloshing displacement left any physical range.

@@ -106,6 +106,14 @@ macro_rules! registry {
             pub fn load(&mut self, state: &[f64]) -> Result<(), String> {
                 match self { $( AnyModel::$variant(m) => m.load(state), )* }
             }
+
+            pub fn extra(&self) -> f64 {
+                match self { $( AnyModel::$variant(m) => m.extra(), )* }
+            }
+
+            pub fn load_extra(&mut self, x: f64) -> Result<(), String> {
+                match self { $( AnyModel::$variant(m) => m.load_extra(x), )* }
+            }
         }
     };
 }
