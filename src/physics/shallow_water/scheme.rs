@@ -78,7 +78,6 @@ impl Rates {
     }
 }
 
-
 /// Velocity of discharge q at depth h, desingularised below the dry depth `dry` (Kurganov &
 /// Petrova 2007): exactly q/h for h >= dry, going smoothly to 0 with h.
 #[inline]
@@ -245,7 +244,6 @@ pub struct March<'a> {
     /// restart of register 1 from U0 (depths, discharges) and the substep's last stage.
     pub restart: Option<([&'a [f64]; 2], f64)>,
 }
-
 
 /// Storage of [`sweep`]: per cell its velocity and its rates, per interface (cells + 1, the
 /// walls included) the depths and velocities behind and ahead of it (the faces of the cells
