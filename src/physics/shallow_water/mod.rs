@@ -80,6 +80,7 @@ macro_rules! builds {
 #[cfg(test)]
 mod exact;
 mod lanes;
+mod reconstruction;
 pub mod scheme;
 pub mod screens;
 mod stages;
@@ -107,6 +108,11 @@ const CFL_BOUND: f64 = 0.5;
 /// The still-water depth below which a cell is dry, relative to the still depth: its liquid
 /// is a film that the bottom's friction stops (its discharge goes to the tank as an impulse).
 pub const DRY: f64 = 1e-9;
+
+/// The depth, relative to the still depth, below which a cell's slopes are limited by
+/// component (minmod on the surface and the velocity) instead of in characteristic variables
+/// ([`scheme`]): films and drying fronts, where the characteristic speed g/c is unbounded.
+pub const THIN: f64 = 1e-3;
 
 /// A tank's liquid as the scheme sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -155,6 +161,7 @@ impl Channel {
             dx: self.dx(),
             g_e: self.g_e,
             dry: DRY * self.depth,
+            thin: THIN * self.depth,
         }
     }
 

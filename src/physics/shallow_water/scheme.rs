@@ -18,13 +18,17 @@
 //!   g_e (H+^2 - H-^2)/2 = -a_b H_i dx exactly (H+ + H- = 2 H_i), so it stays at rest; and
 //!   the sources of all cells sum to -a_b times the mass, which is conserved, so the momentum
 //!   balance closes exactly (h force.mean = -M_l a_b h - Delta P).
-//! - Limiter: minmod on the surface and the velocity; the depth's slope is then cut to
-//!   |dH| <= 2 H so that neither face depth is negative (positivity, Kurganov & Petrova
-//!   2007), which keeps the cell average and so the lake at rest wherever it is wet. The more
-//!   compressive generalised minmod (Van Leer 1979) with theta = 1.5 created energy at the
-//!   wall cells in the first steps from rest under SSPRK3 (dissipated = input - stored then
-//!   decreased, +0.5 % of the input at 40 cells), and its forces converge more slowly near
-//!   1.1 omega_1 (tried again under SSPRK(10,4)); minmod does neither.
+//! - Limiter ([`super::reconstruction`]): monotonised central (MC) on the characteristic
+//!   variables of the linearised equations in (w, u), the Riemann invariants' differentials
+//!   du +- sqrt(g/H) dw; the depth's slope is then cut to |dH| <= 2 H so that neither face
+//!   depth is negative (positivity, Kurganov & Petrova 2007), which keeps the cell average and
+//!   so the lake at rest wherever it is wet (there both differentials are 0). A bore is a jump
+//!   of one family: limited by component, MC (or superbee, van Leer, theta = 1.5) on w sharpens
+//!   it but overshoots the wall force in the step after each bore reaches a wall (+3 % at
+//!   1.1 omega_1, 150 cells); by characteristic the other family is left smooth and the
+//!   overshoot is gone, and the force.mean history at 150 cells is 1.1 % off a converged
+//!   solution against minmod's 2.0 % (docs/SHALLOW_WATER.md). Below 1e-3 h (films, drying
+//!   fronts) minmod on w and u by component, the scheme's limiter before 2026-11-27.
 //! - The velocity, not the discharge, is reconstructed: a face velocity then lies between its
 //!   neighbours' however thin the face's depth, which bounds the wave speeds at a drying front
 //!   (with the discharge reconstructed, q/H of a thin face ran away within a few substeps).
@@ -32,6 +36,7 @@
 //!   mass flux and the momentum flux g_e H^2/2 + H u (u - s), the wall pressure.
 
 use super::lanes::{faster, lane_sum, larger, smaller, whole_chunks};
+use super::reconstruction::{Limiting, faces_of};
 
 /// The discretisation: cells across the tank, their width, gravity with the dispersion
 /// correction, and the depth below which a cell counts as dry.
@@ -41,6 +46,9 @@ pub struct Grid {
     pub dx: f64,
     pub g_e: f64,
     pub dry: f64,
+    /// The depth below which a cell's faces are limited by component (surface and velocity,
+    /// minmod) instead of in characteristic variables: thin films and drying fronts.
+    pub thin: f64,
 }
 
 /// The semi-discrete right-hand side at one state, and what the step needs of it.
@@ -67,18 +75,6 @@ impl Rates {
             mass_flux: vec![0.0; cells.saturating_sub(1)],
             speed: 0.0,
         }
-    }
-}
-
-/// Minmod of the left and right differences: the smaller in magnitude if they have one sign,
-/// else 0 (without branches: vectorisable).
-#[inline(always)]
-fn limited(left: f64, right: f64) -> f64 {
-    let m = smaller(left.abs(), right.abs());
-    if left * right <= 0.0 {
-        0.0
-    } else {
-        m.copysign(left)
     }
 }
 
@@ -165,6 +161,7 @@ fn interior_faces(
     h: &[f64],
     u: &[f64],
     rise: f64,
+    limiting: Limiting,
     faces: [&mut [f64]; 4],
     part: std::ops::Range<usize>,
 ) {
@@ -186,6 +183,7 @@ fn interior_faces(
             [h[1] - h[0] + rise, h[2] - h[1] + rise],
             [u[1] - u[0], u[2] - u[1]],
             rise,
+            limiting,
         );
     }
 }
@@ -245,24 +243,6 @@ pub struct March<'a> {
     /// Instead of moving ahead, U' = U0 + share A (A with this stage's share added): the
     /// restart of register 1 from U0 (depths, discharges) and the substep's last stage.
     pub restart: Option<([&'a [f64]; 2], f64)>,
-}
-
-/// The faces of a cell of depth `depth` and velocity `u` from the differences of the surface
-/// w = H + z and of u across its left and right interfaces, `rise` the pseudo-bottom's rise
-/// from one cell to the next: (left depth, left velocity, right depth, right velocity).
-#[inline(always)]
-fn faces_of(depth: f64, u: f64, dw: [f64; 2], du: [f64; 2], rise: f64) -> (f64, f64, f64, f64) {
-    // Depth slope = surface slope - bottom slope, cut so that no face is negative.
-    // (A NaN depth stays NaN, and the step that made it is refused.)
-    let most = 2.0 * larger(depth, 0.0);
-    let dh = smaller(larger(limited(dw[0], dw[1]) - rise, -most), most);
-    let du = limited(du[0], du[1]);
-    (
-        depth - 0.5 * dh,
-        u - 0.5 * du,
-        depth + 0.5 * dh,
-        u + 0.5 * du,
-    )
 }
 
 /// Storage of [`sweep`]: per cell its velocity and its rates, per interface (cells + 1, the
@@ -392,6 +372,11 @@ pub(super) fn sweep_passes(
     let n = grid.cells;
     let (h, q) = (&h[..n], &q[..n]);
     let (g, dry, dx) = (grid.g_e, grid.dry, grid.dx);
+    let limiting = Limiting {
+        g,
+        inv_g: 1.0 / g,
+        thin: grid.thin,
+    };
     let inv_dx = 1.0 / dx;
     // Rise of the pseudo-bottom z = a x / g_e from one cell centre to the next.
     let rise = a * dx / g;
@@ -433,11 +418,11 @@ pub(super) fn sweep_passes(
     };
     for (i, dw, du) in edges {
         (ahead_h[i], ahead_u[i], behind_h[i + 1], behind_u[i + 1]) =
-            faces_of(h[i], u[i], dw, du, rise);
+            faces_of(h[i], u[i], dw, du, rise, limiting);
     }
     for part in whole_chunks(n.saturating_sub(2)) {
         let faces = [&mut *ahead_h, &mut *ahead_u, &mut *behind_h, &mut *behind_u];
-        interior_faces(h, u, rise, faces, part);
+        interior_faces(h, u, rise, limiting, faces, part);
     }
     // The walls: behind the left one and ahead of the right one, the mirror of the wall
     // cell's face (the depth the same, the velocity reversed).

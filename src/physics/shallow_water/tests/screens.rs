@@ -70,8 +70,8 @@ fn decay_rate(ch: &Channel, eta0: f64, time: f64) -> f64 {
 /// screens of two solidities, and its convergence in cells. The liquid without screens also
 /// loses its wave at a rate growing with the amplitude (the scheme's dissipation of the
 /// steepening wave: measured the same way in the bare tank, it is subtracted), so what is
-/// compared is the screens' part: the error falls as the cells double and is within 2 % at
-/// 200 cells, at this amplitude and at a third of it (where the decay runs twice as long).
+/// compared is the screens' part: within 2 % at every count from 25 to 200 cells, and at 200
+/// cells at a third of this amplitude (where the decay runs twice as long).
 #[test]
 fn free_decay_matches_the_closed_form_equivalent_damping() {
     // The bare tank's decay, once per grid (it does not depend on the screens).
@@ -101,10 +101,12 @@ fn free_decay_matches_the_closed_form_equivalent_damping() {
         eprintln!(
             "screens S = {s}: 200 cells at eta0 = 0.3 % of h: {low:+.4} (bare {bare_low:.3})"
         );
-        for pair in errors.windows(2) {
-            assert!(pair[1].abs() < pair[0].abs(), "S = {s}: {errors:?}");
-        }
-        assert!(errors[3].abs() < 0.02, "S = {s}: {errors:?}");
+        // Every count within 2 % (under the minmod limiter, before 2026-11-27, 25 cells were
+        // 5-6 % off and the error fell at every doubling, which this asserted; with the
+        // characteristic MC limiter every count is within 1.1 % of the closed form and the
+        // counts within 0.3 % of each other, so what is left is the closed form's own
+        // small-amplitude approximation, not the grid's, and falls with no doubling).
+        assert!(errors.iter().all(|e| e.abs() < 0.02), "S = {s}: {errors:?}");
         assert!(low.abs() < 0.02, "S = {s}: {low}");
     }
 }
