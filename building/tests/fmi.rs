@@ -79,6 +79,30 @@ fn bad_input_is_refused_and_changes_nothing() {
     assert_eq!(inst.do_step(0.01), OK, "still usable");
 }
 
+/// A step too long for the exact propagator (coverage-guided fuzzing: steps near 1e300 s made
+/// the matrix exponential take about a thousand squarings each, over a second a step for 20
+/// storeys, to end in NaN) is refused before the exponential is formed, saying why; the
+/// instance is as before and steps on.
+#[test]
+fn a_step_too_long_to_form_is_refused_before_the_exponential() {
+    let mut inst = Instance::new("long-step");
+    inst.initialise(&three_storeys());
+    assert_eq!(inst.set_real(vr::GROUND_A, 0.3), OK);
+    assert_eq!(inst.do_step(0.01), OK);
+    let before = inst.serialised();
+    for h in [1e300, 1e20] {
+        assert_eq!(inst.do_step(h), ERROR, "{h}");
+        let logs = inst.logs().join("\n");
+        assert!(
+            logs.contains("beyond what the exact propagator can form"),
+            "{h}: {logs}"
+        );
+        assert_eq!(inst.serialised(), before);
+    }
+    // A long but formable step (the structure at rest long after the input): taken.
+    assert_eq!(inst.do_step(1e6), OK, "{:?}", inst.logs());
+}
+
 /// Inconsistent parameters are refused at fmi2ExitInitializationMode with the reason; fixed,
 /// the same instance initialises.
 #[test]

@@ -57,6 +57,29 @@ impl Propagator {
     }
 }
 
+/// The largest scaled norm h max(|A|, |B|, 1) (1-norms) whose exponential is formed: scaling and
+/// squaring takes about log2 of it squarings, some 60 here, where a step of 1e300 s took a
+/// thousand (over a second for a 20-storey building, and NaN in the end). A step that long
+/// (1e18 s is 30 times the age of the universe at unit rates) is refused instead.
+pub const MAX_SCALED_NORM: f64 = 1e18;
+
+/// Whether the exponential over `h` can be formed for (A, B) (see [`MAX_SCALED_NORM`]).
+pub fn formable(a: &DMatrix<f64>, b: &DMatrix<f64>, h: f64) -> Result<(), String> {
+    let norm = |m: &DMatrix<f64>| {
+        m.column_iter()
+            .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    };
+    let scaled = h * norm(a).max(norm(b)).max(1.0);
+    if scaled <= MAX_SCALED_NORM {
+        Ok(())
+    } else {
+        Err(format!(
+            "a step of {h:e} s is beyond what the exact propagator can form for this building (h times its largest rate {scaled:e} > {MAX_SCALED_NORM:e})"
+        ))
+    }
+}
+
 /// The propagators of the step sizes used last: hosts keep one step size or alternate a few
 /// (rounding of accumulated time), so a handful spares recomputing the exponential.
 #[derive(Clone, Debug, Default)]
@@ -67,8 +90,14 @@ pub struct Cache {
 const CACHED: usize = 4;
 
 impl Cache {
-    /// The propagator over `h`, made from (A, B) if it is not cached.
-    pub fn get(&mut self, h: f64, a: &DMatrix<f64>, b: &DMatrix<f64>) -> &Propagator {
+    /// The propagator over `h`, made from (A, B) if it is not cached; refused for a step too
+    /// long to form ([`formable`]).
+    pub fn get(
+        &mut self,
+        h: f64,
+        a: &DMatrix<f64>,
+        b: &DMatrix<f64>,
+    ) -> Result<&Propagator, String> {
         let found = self
             .entries
             .iter()
@@ -76,6 +105,7 @@ impl Cache {
         let k = match found {
             Some(k) => k,
             None => {
+                formable(a, b, h)?;
                 if self.entries.len() == CACHED {
                     self.entries.remove(0);
                 }
@@ -83,7 +113,7 @@ impl Cache {
                 self.entries.len() - 1
             }
         };
-        &self.entries[k]
+        Ok(&self.entries[k])
     }
 }
 
@@ -118,7 +148,7 @@ mod tests {
         let b = DMatrix::from_element(1, 1, 1.0);
         let mut cache = Cache::default();
         for h in [0.1, 0.2, 0.1, 0.3, 0.4, 0.5, 0.1] {
-            assert_eq!(cache.get(h, &a, &b).h, h);
+            assert_eq!(cache.get(h, &a, &b).map(|p| p.h), Ok(h));
         }
         assert!(cache.entries.len() <= CACHED);
     }

@@ -306,7 +306,15 @@ impl Slave for Building {
             self.fill_channels(&s.building, order, &mut s.p[order * m..(order + 1) * m]);
         }
         let (a, b) = (&s.a, &s.b);
-        s.cache.get(h, a, b).advance(&s.z, &s.p, &mut s.next);
+        match s.cache.get(h, a, b) {
+            Ok(propagator) => propagator.advance(&s.z, &s.p, &mut s.next),
+            Err(why) => {
+                self.sim = Some(s);
+                return Err(refuse(format!(
+                    "fmi2DoStep from t = {t} by {h}: {why}. The state is left at the start of the step."
+                )));
+            }
+        }
         if !s.next.iter().all(|x| finite(*x)) {
             self.sim = Some(s);
             return Err(refuse(format!(
