@@ -8,6 +8,8 @@ mod access;
 mod generated_tests;
 mod me;
 mod me_cells;
+#[cfg(test)]
+mod me_tests;
 mod params;
 mod slave;
 mod snapshot;
