@@ -12,6 +12,7 @@ use super::slave::Tld;
 use super::vars::{VARIABLES, VarType, vr};
 use crate::model::continuous::{ALL_STATES, BANK, STATES};
 use crate::physics::amplitude::TRACKER_CONTINUOUS;
+use crate::physics::amplitude_tests::estimator_odes;
 use fmi2_slave::calls::Phase;
 use fmi2_slave::frame::Experiment;
 use fmi2_slave::{Context, Continuous, Refusal, Slave, Status};
@@ -438,17 +439,7 @@ fn nominals_are_the_scales_and_one_where_a_scale_vanishes() {
 fn the_estimators_states_and_rates_are_its_odes() {
     let (_, w) = mode_one();
     let (tau, leak) = (1.5, 0.05 * w);
-    let odes = |s: &[f64], a: f64, v: f64| -> [f64; TRACKER_CONTINUOUS] {
-        [
-            a - leak * s[0],
-            (v * v - s[1]) / tau,
-            (s[1] - s[2]) / tau,
-            (a * a - s[3]) / tau,
-            (s[3] - s[4]) / tau,
-            (1.0 - s[5]) / tau,
-            (s[5] - s[6]) / tau,
-        ]
-    };
+    let odes = |s: &[f64], a: f64, v: f64| estimator_odes(s, a, v, tau, leak);
     let more = [(vr::AMPLITUDE_TAU, tau)];
     let mut tld = initialised(instance(LINEAR, TRACKED, 0.004, &more));
     let mut s = states(&tld);

@@ -13,17 +13,28 @@ const LEAK: f64 = 0.27;
 const PRIOR: f64 = 0.002;
 
 /// The estimator's ODEs written out from their definitions: the state [rebuilt v, <v^2> first,
-/// second, <a^2> first, second, weight first, second], the velocity `v` that feeds <v^2>.
-fn odes(s: &[f64; TRACKER_CONTINUOUS], a: f64, v: f64) -> [f64; TRACKER_CONTINUOUS] {
+/// second, <a^2> first, second, weight first, second], the velocity `v` that feeds <v^2>, time
+/// constant `tau`, leak `leak` (also the reference of the FMI layer's tests).
+pub(crate) fn estimator_odes(
+    s: &[f64],
+    a: f64,
+    v: f64,
+    tau: f64,
+    leak: f64,
+) -> [f64; TRACKER_CONTINUOUS] {
     [
-        a - LEAK * s[0],
-        (v * v - s[1]) / TAU,
-        (s[1] - s[2]) / TAU,
-        (a * a - s[3]) / TAU,
-        (s[3] - s[4]) / TAU,
-        (1.0 - s[5]) / TAU,
-        (s[5] - s[6]) / TAU,
+        a - leak * s[0],
+        (v * v - s[1]) / tau,
+        (s[1] - s[2]) / tau,
+        (a * a - s[3]) / tau,
+        (s[3] - s[4]) / tau,
+        (1.0 - s[5]) / tau,
+        (s[5] - s[6]) / tau,
     ]
+}
+
+fn odes(s: &[f64; TRACKER_CONTINUOUS], a: f64, v: f64) -> [f64; TRACKER_CONTINUOUS] {
+    estimator_odes(s, a, v, TAU, LEAK)
 }
 
 /// RK4 of [`odes`] over `h` in `n` steps, base.a = `a` held; the velocity that feeds <v^2> is

@@ -3,7 +3,7 @@
 
 pub mod amplitude;
 #[cfg(test)]
-mod amplitude_tests;
+pub(crate) mod amplitude_tests;
 pub mod base;
 pub mod geometry;
 pub mod laws;
