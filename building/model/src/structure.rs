@@ -356,6 +356,49 @@ mod tests {
         assert!(close(low.omega, roof.omega));
     }
 
+    /// A damper floor that hardly moves in the first mode is refused, one that moves little is
+    /// taken: two storeys of mass m, the lower far stiffer (k1 >> k2), where the first mode has
+    /// phi_1/phi_2 = k2/(k1 + k2 - w^2 m), w^2 the smaller root of det(K - w^2 M) = 0 (written
+    /// out by hand). At k1/k2 = 1e8 floor 1 moves about 1e-8 of floor 2 (taken: the shape
+    /// normalised at floor 1 has floor 2 at the inverse ratio); at 1e10, 1e-10 (refused, below
+    /// 1e-9 of the largest component). Masses of 1e4 kg make the unnormalised shape's largest
+    /// component 1e-2, so that a threshold of 1e-9 / amax (for 1e-9 amax) refuses the first too.
+    #[test]
+    fn a_damper_floor_still_in_the_first_mode_is_refused() {
+        let (m, k2) = (1.0e4, 1.0e6);
+        let build = |k1: f64| {
+            Building::new(&Design {
+                masses: vec![m, m],
+                stiffnesses: vec![k1, k2],
+                zeta: [0.02, 0.03],
+                damper_floor: 1,
+                damper_mass: 0.0,
+                ground: Harmonic::default(),
+            })
+            .expect("valid")
+            .first_mode()
+        };
+        let ratio = |k1: f64| {
+            // det = m^2 w^4 - m (k1 + 2 k2) w^2 + k1 k2 = 0, the smaller root.
+            let (b, c) = (m * (k1 + 2.0 * k2), k1 * k2);
+            let w2 = 2.0 * c / (b + (b * b - 4.0 * m * m * c).sqrt());
+            k2 / (k1 + k2 - w2 * m)
+        };
+        let taken = build(1.0e14).expect("floor 1 moves 1e-8 of floor 2");
+        let want = 1.0 / ratio(1.0e14);
+        assert!((taken.shape[0] - 1.0).abs() < 1e-15);
+        assert!(
+            (taken.shape[1] / want - 1.0).abs() < 1e-6,
+            "{} vs {want}",
+            taken.shape[1]
+        );
+        let why = build(1.0e16).expect_err("floor 1 moves 1e-10 of floor 2");
+        assert!(
+            why.contains("floor 1 does not move in the first mode"),
+            "{why}"
+        );
+    }
+
     /// Two storeys: omega^2 are the roots of det(K - w^2 M) = 0, written out by hand.
     #[test]
     fn two_storey_frequencies_are_the_roots_of_the_characteristic_polynomial() {
