@@ -399,6 +399,32 @@ mod tests {
         );
     }
 
+    /// The first-order state is [u, u', x_g, v_g, h, v_h] for any number of storeys: 2 n + 4
+    /// values, at rest but for the ground's velocity and the built-in motion's, both A w.
+    #[test]
+    fn the_state_holds_each_floor_twice_then_the_ground_and_its_motion() {
+        let ground = Harmonic {
+            amplitude: 0.03,
+            omega: 1.7,
+        };
+        for n in [1, 3, 4] {
+            let b = Building::new(&Design {
+                masses: vec![1.0e4; n],
+                stiffnesses: vec![2.0e6; n],
+                zeta: [0.02, 0.03],
+                damper_floor: n,
+                damper_mass: 0.0,
+                ground,
+            })
+            .expect("valid");
+            assert_eq!(b.states(), 2 * n + 4);
+            let mut want = vec![0.0; 2 * n + 4];
+            want[2 * n + 1] = 0.03 * 1.7;
+            want[2 * n + 3] = 0.03 * 1.7;
+            assert_eq!(b.initial_state(), want, "{n} storeys");
+        }
+    }
+
     /// Two storeys: omega^2 are the roots of det(K - w^2 M) = 0, written out by hand.
     #[test]
     fn two_storey_frequencies_are_the_roots_of_the_characteristic_polynomial() {
