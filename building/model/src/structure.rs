@@ -400,7 +400,8 @@ mod tests {
     }
 
     /// The first-order state is [u, u', x_g, v_g, h, v_h] for any number of storeys: 2 n + 4
-    /// values, at rest but for the ground's velocity and the built-in motion's, both A w.
+    /// values, at rest but for the ground's velocity and the built-in motion's, both A w; the
+    /// ground acceleration reads h from it (w = 1.7: w^2 is not 2 w).
     #[test]
     fn the_state_holds_each_floor_twice_then_the_ground_and_its_motion() {
         let ground = Harmonic {
@@ -422,6 +423,10 @@ mod tests {
             want[2 * n + 1] = 0.03 * 1.7;
             want[2 * n + 3] = 0.03 * 1.7;
             assert_eq!(b.initial_state(), want, "{n} storeys");
+            // a_g = the input's + the built-in motion's -w^2 h (h the state's 2n + 3rd).
+            want[2 * n + 2] = 0.004;
+            let a_g = b.ground_acceleration(&want, 0.25);
+            assert!((a_g - (0.25 - 1.7 * 1.7 * 0.004)).abs() < 1e-15, "{a_g}");
         }
     }
 
