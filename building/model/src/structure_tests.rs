@@ -132,3 +132,26 @@ fn state_space_is_the_equation_of_motion_for_any_storeys() {
         );
     }
 }
+
+/// Base shear 1^T (K u + C v) in closed form: K's columns sum to 0 but the first's, k_1, so
+/// 1^T K u = k_1 u_1, and with C = alpha M + beta K, 1^T C v = alpha sum m_i v_i + beta k_1 v_1
+/// (three storeys of their own masses and stiffnesses).
+#[test]
+fn base_shear_is_the_first_storeys_spring_and_the_damping_to_the_ground() {
+    let (masses, stiffnesses) = (vec![3.0e4, 2.0e4, 1.5e4], vec![5.0e6, 3.0e6, 2.0e6]);
+    let b = Building::new(&Design {
+        masses: masses.clone(),
+        stiffnesses: stiffnesses.clone(),
+        zeta: [0.02, 0.03],
+        damper_floor: 3,
+        damper_mass: 0.0,
+        ground: Harmonic::default(),
+    })
+    .expect("valid");
+    let (u, v) = ([0.012, 0.019, 0.031], [-0.05, 0.02, 0.07]);
+    let momentum: f64 = masses.iter().zip(v).map(|(m, v)| m * v).sum();
+    let want = stiffnesses[0] * u[0] + b.alpha * momentum + b.beta * stiffnesses[0] * v[0];
+    let got = b.base_shear(&u, &v);
+    assert!((got / want - 1.0).abs() < 1e-12, "{got} vs {want}");
+    assert!(b.alpha * momentum != 0.0 && b.beta != 0.0);
+}
