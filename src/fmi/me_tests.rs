@@ -597,3 +597,36 @@ fn me_functions_refuse_without_a_simulation_they_can_integrate() {
     );
     assert_eq!(states(&tld), before);
 }
+
+/// A host learns the number of continuous states from the model description, one der(...)
+/// variable per state: ALL_STATES (and so the arrays of every ME call) must be that number.
+#[test]
+fn the_state_count_is_the_model_descriptions() {
+    let derivatives = VARIABLES
+        .iter()
+        .filter(|v| v.name.starts_with("der("))
+        .count();
+    assert_eq!(ALL_STATES, derivatives);
+}
+
+/// amplitude = Tracked: the estimator's nominals are those of harmonic base motion of the
+/// prior amplitude A_e at w_1: its velocity A_e w_1, the squares of that and of its
+/// acceleration A_e w_1^2, the weights 1.
+#[test]
+fn the_estimators_nominals_are_harmonic_motion_at_the_prior() {
+    let (_, w) = mode_one();
+    let a_e = 0.004;
+    let tld = initialised(instance(LINEAR, TRACKED, a_e, &[(vr::AMPLITUDE_TAU, 1.5)]));
+    let mut n = vec![f64::NAN; ALL_STATES];
+    assert_eq!(tld.nominals(&mut n).ok(), Some(Status::Ok));
+    let (v, a) = (a_e * w, a_e * w * w);
+    let want = [v, v * v, v * v, a * a, a * a, 1.0, 1.0];
+    for (k, want) in want.into_iter().enumerate() {
+        close(
+            n[T0 + k],
+            want,
+            1e-12,
+            &format!("the estimator's nominal {k}"),
+        );
+    }
+}
