@@ -12,18 +12,17 @@ use super::slave::Tld;
 use super::vars::{VARIABLES, VarType, vr};
 use crate::model::continuous::{ALL_STATES, BANK, STATES};
 use crate::physics::amplitude::TRACKER_CONTINUOUS;
-use crate::physics::amplitude_tests::estimator_odes;
 use fmi2_slave::calls::Phase;
 use fmi2_slave::frame::Experiment;
 use fmi2_slave::{Context, Continuous, Refusal, Slave, Status};
 
 /// Enumeration items (modelDescription.xml).
-const LINEAR: i32 = 1;
+pub(super) const LINEAR: i32 = 1;
 const SLAMMING: i32 = 3;
 const SHALLOW_WATER: i32 = 5;
 const CONSTANT: i32 = 1;
-const FIXED: i32 = 1;
-const TRACKED: i32 = 2;
+pub(super) const FIXED: i32 = 1;
+pub(super) const TRACKED: i32 = 2;
 /// A tank that is not the defaults' (no product of its numbers 1), two of them.
 const A: f64 = 0.6;
 const B: f64 = 0.25;
@@ -32,9 +31,9 @@ const TANKS: f64 = 2.0;
 const ZETA: f64 = 0.04;
 const X0: f64 = 0.015;
 /// The tracker's position among all states.
-const T0: usize = STATES;
+pub(super) const T0: usize = STATES;
 
-fn context(phase: Phase) -> Context {
+pub(super) fn context(phase: Phase) -> Context {
     Context {
         phase,
         experiment: Experiment::default(),
@@ -43,7 +42,7 @@ fn context(phase: Phase) -> Context {
 }
 
 /// The value reference of the variable named `name` in the model description.
-fn named(name: &str) -> u32 {
+pub(super) fn named(name: &str) -> u32 {
     VARIABLES
         .iter()
         .find(|v| v.name == name)
@@ -52,7 +51,7 @@ fn named(name: &str) -> u32 {
 }
 
 /// The estimator's state k and its derivative, by name.
-fn tracker_vr(k: usize, derivative: bool) -> u32 {
+pub(super) fn tracker_vr(k: usize, derivative: bool) -> u32 {
     let names = [
         "v",
         "v2[1]",
@@ -72,7 +71,7 @@ fn tracker_vr(k: usize, derivative: bool) -> u32 {
 
 /// An instance in initialisation mode with one mode of `model` in the test's tank, constant
 /// damping, the amplitude `amplitude` with A_e = `a_e`, and `more` parameters.
-fn instance(model: i32, amplitude: i32, a_e: f64, more: &[(u32, f64)]) -> Tld {
+pub(super) fn instance(model: i32, amplitude: i32, a_e: f64, more: &[(u32, f64)]) -> Tld {
     let mut tld = Tld::new();
     let c = context(Phase::InitializationMode);
     let ints = [
@@ -107,7 +106,7 @@ fn instance(model: i32, amplitude: i32, a_e: f64, more: &[(u32, f64)]) -> Tld {
     tld
 }
 
-fn set_real(tld: &mut Tld, phase: Phase, r: u32, v: f64) {
+pub(super) fn set_real(tld: &mut Tld, phase: Phase, r: u32, v: f64) {
     let set = tld.set(
         &context(phase),
         &[r],
@@ -119,7 +118,7 @@ fn set_real(tld: &mut Tld, phase: Phase, r: u32, v: f64) {
     assert_eq!(set.map_err(|e| e.message), Ok(Status::Ok), "{r} = {v}");
 }
 
-fn real(tld: &Tld, phase: Phase, r: u32) -> f64 {
+pub(super) fn real(tld: &Tld, phase: Phase, r: u32) -> f64 {
     let mut out = [f64::NAN];
     let got = tld.get(
         &context(phase),
@@ -134,18 +133,18 @@ fn real(tld: &Tld, phase: Phase, r: u32) -> f64 {
 }
 
 /// Out of initialisation mode, as fmi2ExitInitializationMode does.
-fn initialised(mut tld: Tld) -> Tld {
+pub(super) fn initialised(mut tld: Tld) -> Tld {
     let warnings = tld.initialise(&context(Phase::InitializationMode));
     assert!(warnings.is_ok(), "{:?}", warnings.err().map(|e| e.message));
     tld
 }
 
-fn ct() -> Context {
+pub(super) fn ct() -> Context {
     context(Phase::ContinuousTimeMode)
 }
 
 /// Eq 2.1's fundamental mode of all the tanks: (m_1, omega_1).
-fn mode_one() -> (f64, f64) {
+pub(super) fn mode_one() -> (f64, f64) {
     let pi = std::f64::consts::PI;
     let r = H / A;
     let t = (pi * r).tanh();
@@ -153,20 +152,20 @@ fn mode_one() -> (f64, f64) {
     (mass, (9.81 * pi * t / A).sqrt())
 }
 
-fn close(got: f64, want: f64, rel: f64, what: &str) {
+pub(super) fn close(got: f64, want: f64, rel: f64, what: &str) {
     assert!(
         (got - want).abs() <= rel * want.abs().max(1e-300),
         "{what}: {got} vs {want}"
     );
 }
 
-fn states(tld: &Tld) -> Vec<f64> {
+pub(super) fn states(tld: &Tld) -> Vec<f64> {
     let mut x = vec![f64::NAN; ALL_STATES];
     assert_eq!(tld.states(&mut x).map_err(|e| e.message), Ok(Status::Ok));
     x
 }
 
-fn derivatives(tld: &Tld) -> Vec<f64> {
+pub(super) fn derivatives(tld: &Tld) -> Vec<f64> {
     let mut dx = vec![f64::NAN; ALL_STATES];
     let got = tld.derivatives(&ct(), &mut dx);
     assert_eq!(got.map_err(|e| e.message), Ok(Status::Ok));
@@ -430,53 +429,6 @@ fn nominals_are_the_scales_and_one_where_a_scale_vanishes() {
     }
 }
 
-/// amplitude = Tracked: the estimator's states follow the others, are read back as set and as
-/// the variables A_e.tracker.*; their derivatives are the estimator's ODEs (tau given, w_c =
-/// w_1/20, the rebuilt velocity feeding <v^2>); a base.v other than 0 asks for an event at the
-/// end of the integrator's step, the event switches the estimator (states changed) once, and
-/// then the measured velocity feeds <v^2>.
-#[test]
-fn the_estimators_states_and_rates_are_its_odes() {
-    let (_, w) = mode_one();
-    let (tau, leak) = (1.5, 0.05 * w);
-    let odes = |s: &[f64], a: f64, v: f64| estimator_odes(s, a, v, tau, leak);
-    let more = [(vr::AMPLITUDE_TAU, tau)];
-    let mut tld = initialised(instance(LINEAR, TRACKED, 0.004, &more));
-    let mut s = states(&tld);
-    let t = [0.37, 0.011, 0.0093, 0.41, 0.33, 0.64, 0.45];
-    s[T0..T0 + TRACKER_CONTINUOUS].copy_from_slice(&t);
-    assert!(tld.set_states(&ct(), &s).is_ok());
-    assert_eq!(states(&tld), s);
-    let a = -0.73;
-    set_real(&mut tld, Phase::ContinuousTimeMode, vr::BASE_A, a);
-    let dx = derivatives(&tld);
-    let want = odes(&t, a, t[0]);
-    let p = Phase::ContinuousTimeMode;
-    for k in 0..TRACKER_CONTINUOUS {
-        close(dx[T0 + k], want[k], 1e-14, &format!("rate {k}"));
-        assert_eq!(real(&tld, p, tracker_vr(k, false)), t[k], "state {k}");
-        assert_eq!(real(&tld, p, tracker_vr(k, true)), dx[T0 + k], "der {k}");
-    }
-    assert_eq!(dx[0], s[1], "der(slosh.x)");
-    assert_eq!(tld.completed_step(&ct()).ok(), Some(false));
-    let update = tld.event_update(&context(Phase::EventMode)).expect("event");
-    assert!(!update.states_changed);
-    // The host drives base.v: an event at the end of the step, which switches the estimator.
-    set_real(&mut tld, p, vr::BASE_V, 0.29);
-    assert_eq!(tld.completed_step(&ct()).ok(), Some(true));
-    let update = tld.event_update(&context(Phase::EventMode)).expect("event");
-    assert!(update.states_changed);
-    assert_eq!(tld.completed_step(&ct()).ok(), Some(false));
-    let update = tld.event_update(&context(Phase::EventMode)).expect("event");
-    assert!(!update.states_changed, "the switch is once");
-    let s = states(&tld);
-    let dx = derivatives(&tld);
-    let want = odes(&s[T0..], a, 0.29);
-    for k in 0..TRACKER_CONTINUOUS {
-        close(dx[T0 + k], want[k], 1e-14, &format!("measured: rate {k}"));
-    }
-}
-
 /// S^2: the event indicators are the gaps to the walls (d/2 -+ z, the wall moved away from a
 /// clearance further); an impact is an event that changes the states (the impact mass
 /// rebounds), after which the mass moves away and the next iteration changes nothing.
@@ -607,26 +559,4 @@ fn the_state_count_is_the_model_descriptions() {
         .filter(|v| v.name.starts_with("der("))
         .count();
     assert_eq!(ALL_STATES, derivatives);
-}
-
-/// amplitude = Tracked: the estimator's nominals are those of harmonic base motion of the
-/// prior amplitude A_e at w_1: its velocity A_e w_1, the squares of that and of its
-/// acceleration A_e w_1^2, the weights 1.
-#[test]
-fn the_estimators_nominals_are_harmonic_motion_at_the_prior() {
-    let (_, w) = mode_one();
-    let a_e = 0.004;
-    let tld = initialised(instance(LINEAR, TRACKED, a_e, &[(vr::AMPLITUDE_TAU, 1.5)]));
-    let mut n = vec![f64::NAN; ALL_STATES];
-    assert_eq!(tld.nominals(&mut n).ok(), Some(Status::Ok));
-    let (v, a) = (a_e * w, a_e * w * w);
-    let want = [v, v * v, v * v, a * a, a * a, 1.0, 1.0];
-    for (k, want) in want.into_iter().enumerate() {
-        close(
-            n[T0 + k],
-            want,
-            1e-12,
-            &format!("the estimator's nominal {k}"),
-        );
-    }
 }

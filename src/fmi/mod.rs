@@ -10,6 +10,8 @@ mod me;
 mod me_cells;
 #[cfg(test)]
 mod me_tests;
+#[cfg(test)]
+mod me_tracked_tests;
 mod params;
 mod slave;
 mod snapshot;
