@@ -8,6 +8,10 @@ mod access;
 mod generated_tests;
 mod me;
 mod me_cells;
+#[cfg(test)]
+mod me_tests;
+#[cfg(test)]
+mod me_tracked_tests;
 mod params;
 mod slave;
 mod snapshot;

@@ -2,6 +2,8 @@
 //! Plain Rust: no FFI and nothing of FMI here.
 
 pub mod amplitude;
+#[cfg(test)]
+pub(crate) mod amplitude_tests;
 pub mod base;
 pub mod geometry;
 pub mod laws;

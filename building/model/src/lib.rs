@@ -11,5 +11,7 @@ pub mod description;
 pub mod propagator;
 pub mod slave;
 pub mod structure;
+#[cfg(test)]
+mod structure_tests;
 
 pub use slave::Building;

@@ -252,8 +252,8 @@ fn auto_outputs_are_the_reference_integration() {
 /// a ramp, a parabola, or an input whose terms cancel at the step's end; through the centre
 /// fast; with a free oscillation and an input whose deflections cancel; a step of 2/omega_f
 /// (the static deflection 2/omega^2 equal to h/omega); and a small input just above the
-/// threshold; a 10 s step under a slow parabola. The state after every step is the nonlinear
-/// one: x, v, force.
+/// threshold; a 10 s step under a slow parabola; a free amplitude of 1 m. The state after every
+/// step is the nonlinear one: x, v, force.
 #[test]
 fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
     let w = natural(1).1;
@@ -268,7 +268,7 @@ fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
     let c = 2.0 * nsd_zeta(a_e) * w;
     let mass = natural(1).0;
     // (x0, v0, step, input): the hardening phi (2|x|/a)^2 reaches 1e-6 at |x| = 1.25e-4 m.
-    let cases: [(f64, f64, f64, [f64; 3]); 14] = [
+    let cases: [(f64, f64, f64, [f64; 3]); 15] = [
         (1e-5, 0.0, 0.05, [1e-4, 0.0, 0.0]),
         (0.0, 1e-5 * w, 0.05, [0.0, 0.0, 0.0]),
         (-1e-5, 0.0, 0.05, [0.0, 1e-3, 0.0]),
@@ -284,6 +284,9 @@ fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
         (0.0, 0.0, 0.4, [0.0039, 0.0, 0.0]),
         // A 10 s step under a slow parabola: the input's bound must grow as h^2.
         (0.0, 0.0, 10.0, [0.0, 0.0, 1.1e-4]),
+        // A free amplitude just above 1 m (v0 a hair above w_f): refused. (v0 % w_f for
+        // v0 / w_f would read it as 1e-9 m.)
+        (0.0, w * (1.0 + 1e-9), 0.05, [0.0, 0.0, 0.0]),
     ];
     for (x0, v0, h, a) in cases {
         let q = p.clone().with(vr::SLOSH_X0, x0).with(vr::SLOSH_V0, v0);

@@ -89,3 +89,36 @@ fn screens_response_random_takes_a_e_as_the_rms_response() {
             > 0.1
     );
 }
+
+/// The Screens law's K (zeta_s = K X, MODEL.md 9) as the damper reads it from the parameters:
+/// K = (2/3) C_l (m_1/M_l) sum_j |sin(pi x_j/a)|^3 / a, with the loss coefficient C_l given, two
+/// screens evenly spaced (x_j = a/3, 2a/3: sum 2 (sqrt(3)/2)^3) and Eq 2.1's mass ratio
+/// m_1/M_l = 8 tanh(pi r)/(pi^3 r), r = h/a, in a tank that is not the defaults' (three of them:
+/// the ratio is per tank and total alike). Guards the mass ratio's `/` (m_1 M_l for m_1/M_l).
+#[test]
+fn screens_k_is_model_9s_with_eq_2_1s_mass_ratio() {
+    use crate::physics::laws::DampingLaw;
+    let (a, h, loss) = (0.7, 0.09, 2.6);
+    let p = defaults()
+        .with(vr::MODEL, LINEAR)
+        .with(vr::DAMPING, SCREENS)
+        .with(vr::SCREENS_COUNT, 2.0)
+        .with(vr::SCREENS_LOSS, loss)
+        .with(vr::TANK_LENGTH, a)
+        .with(vr::TANK_BREADTH, 0.35)
+        .with(vr::TANK_DEPTH, h)
+        .with(vr::TANKS, 3.0);
+    let DampingLaw::Screens { per_response, .. } = Common::read(&p).expect("parameters").0.damping
+    else {
+        panic!("the Screens law")
+    };
+    let pi = std::f64::consts::PI;
+    let r = h / a;
+    let ratio = 8.0 * (pi * r).tanh() / (pi.powi(3) * r);
+    let cubes = 2.0 * (0.75f64.sqrt()).powi(3);
+    let want = 2.0 / 3.0 * loss * ratio * cubes / a;
+    assert!(
+        (per_response / want - 1.0).abs() < 1e-12,
+        "{per_response} vs {want}"
+    );
+}
