@@ -11,6 +11,8 @@ use super::amplitude::{AmplitudeTracker, TRACKER_CONTINUOUS, TRACKER_STATE};
 const TAU: f64 = 1.3;
 const LEAK: f64 = 0.27;
 const PRIOR: f64 = 0.002;
+/// The prior's frequency (harmonic motion at PRIOR) [rad/s].
+const PRIOR_OMEGA: f64 = 5.6;
 
 /// The estimator's ODEs written out from their definitions: the state [rebuilt v, <v^2> first,
 /// second, <a^2> first, second, weight first, second], the velocity `v` that feeds <v^2>, time
@@ -69,7 +71,7 @@ const STATE: [f64; TRACKER_CONTINUOUS] = [0.37, 0.011, 0.0093, 0.41, 0.33, 0.64,
 /// measured one after (whatever velocity is passed before).
 #[test]
 fn continuous_rates_are_the_estimators_odes() {
-    let mut tracker = AmplitudeTracker::new(TAU, LEAK, PRIOR);
+    let mut tracker = AmplitudeTracker::new(TAU, LEAK, PRIOR, PRIOR_OMEGA);
     tracker.set_continuous_state(&STATE).expect("finite");
     let (a, v) = (-0.73, 0.29);
     // base.v not yet seen: <v^2> is fed by the rebuilt velocity, base.v ignored.
@@ -110,7 +112,7 @@ fn continuous_rates_are_the_estimators_odes() {
 fn an_update_solves_the_rates_with_each_second_stage_fed_the_first_held() {
     for h in [0.01, 0.37, 2.9] {
         for measured in [None, Some(-0.19)] {
-            let mut tracker = AmplitudeTracker::new(TAU, LEAK, PRIOR);
+            let mut tracker = AmplitudeTracker::new(TAU, LEAK, PRIOR, PRIOR_OMEGA);
             if let Some(v) = measured {
                 assert!(tracker.sees_velocity(v));
             }
@@ -145,7 +147,7 @@ fn an_update_solves_the_rates_with_each_second_stage_fed_the_first_held() {
 #[test]
 fn the_continuous_state_is_the_saved_state_without_its_flag() {
     for measured in [false, true] {
-        let mut tracker = AmplitudeTracker::new(TAU, LEAK, PRIOR);
+        let mut tracker = AmplitudeTracker::new(TAU, LEAK, PRIOR, PRIOR_OMEGA);
         if measured {
             assert!(tracker.sees_velocity(0.2));
         }
@@ -167,7 +169,9 @@ fn the_continuous_state_is_the_saved_state_without_its_flag() {
         tracker.set_continuous_state(&trial).expect("finite");
         assert_eq!(tracker.continuous_state(), trial);
         let s = tracker.state();
-        assert_eq!(s[1], saved[1], "the velocity source stays");
+        // The velocity source stays; the flag's 2 says the estimate is now the continuous one
+        // (Model Exchange's, from the first state a host sets).
+        assert_eq!(s[1], saved[1] + 2.0, "the velocity source stays");
         assert_eq!(
             [s[0], s[2], s[3], s[4], s[5], s[6], s[7]],
             trial,
@@ -189,7 +193,7 @@ fn the_continuous_state_is_the_saved_state_without_its_flag() {
 /// the rebuilt velocity; base.v = 0 never switches.
 #[test]
 fn a_measured_velocity_switches_the_estimator_once() {
-    let mut tracker = AmplitudeTracker::new(TAU, LEAK, PRIOR);
+    let mut tracker = AmplitudeTracker::new(TAU, LEAK, PRIOR, PRIOR_OMEGA);
     for k in 0..20 {
         tracker.update(0.05, 0.5 * (0.3 * k as f64).sin() + 0.2, 0.0);
     }
@@ -213,7 +217,7 @@ fn a_measured_velocity_switches_the_estimator_once() {
     }
     assert_eq!(tracker.state(), after);
     // The same through an update: the first base.v other than 0 restarts the statistics.
-    let mut updated = AmplitudeTracker::new(TAU, LEAK, PRIOR);
+    let mut updated = AmplitudeTracker::new(TAU, LEAK, PRIOR, PRIOR_OMEGA);
     updated.update(0.05, 0.4, 0.0);
     updated.update(0.05, 0.4, 0.0);
     let mut switched = updated.clone();
@@ -228,17 +232,18 @@ fn a_measured_velocity_switches_the_estimator_once() {
 /// difference in any one setting or in the state alone makes them differ.
 #[test]
 fn trackers_are_equal_by_settings_and_state() {
-    let fresh = AmplitudeTracker::new(TAU, LEAK, PRIOR);
-    assert_eq!(fresh, AmplitudeTracker::new(TAU, LEAK, PRIOR));
+    let fresh = AmplitudeTracker::new(TAU, LEAK, PRIOR, PRIOR_OMEGA);
+    assert_eq!(fresh, AmplitudeTracker::new(TAU, LEAK, PRIOR, PRIOR_OMEGA));
     for other in [
-        AmplitudeTracker::new(1.1 * TAU, LEAK, PRIOR),
-        AmplitudeTracker::new(TAU, 1.1 * LEAK, PRIOR),
-        AmplitudeTracker::new(TAU, LEAK, 1.1 * PRIOR),
+        AmplitudeTracker::new(1.1 * TAU, LEAK, PRIOR, PRIOR_OMEGA),
+        AmplitudeTracker::new(TAU, LEAK, PRIOR, 1.1 * PRIOR_OMEGA),
+        AmplitudeTracker::new(TAU, 1.1 * LEAK, PRIOR, PRIOR_OMEGA),
+        AmplitudeTracker::new(TAU, LEAK, 1.1 * PRIOR, PRIOR_OMEGA),
     ] {
         assert_ne!(fresh, other);
     }
     // Same state, another interval seen last: equal.
-    let mut stepped = AmplitudeTracker::new(TAU, LEAK, PRIOR);
+    let mut stepped = AmplitudeTracker::new(TAU, LEAK, PRIOR, PRIOR_OMEGA);
     stepped.update(0.5, 0.3, 0.0);
     assert_ne!(fresh, stepped, "the state alone differs");
     stepped.set_state(&fresh.state()).expect("a fresh state");
