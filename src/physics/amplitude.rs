@@ -40,7 +40,10 @@ impl<const N: usize> MeanSquare<N> {
 
 impl<const N: usize> MeanSquare<N> {
     /// The filters' time derivatives under `sample`, time constant `tau`: the ODEs whose exact
-    /// solution for a held sample [`MeanSquare::update`] is.
+    /// solution for a held sample [`MeanSquare::update`]'s first stage is; its second stage is
+    /// fed the first stage's new value, held, not its path, and differs from these ODEs'
+    /// solution by (first - sample) e^(-h/tau) (1 - e^(-h/tau) - h/tau), second order in h/tau
+    /// (physics::amplitude_tests checks it).
     fn rates(&self, tau: f64, sample: [f64; N]) -> ([f64; N], [f64; N]) {
         (
             std::array::from_fn(|k| (sample[k] - self.first[k]) / tau),
