@@ -53,6 +53,18 @@ fn held(a: f64) -> Inputs {
 }
 
 /// Eq 2.1's fundamental mode of all the tanks: (m_1, omega_1).
+/// S^2's impact mass pressed onto the wall +d/2 (the base accelerating towards -x), at rest
+/// there (an event that says so): the damper's states then, from `s` otherwise.
+fn rest_on_the_wall(d: &mut Damper, mut s: [f64; STATES]) -> [f64; STATES] {
+    (s[IMPACT_Z], s[IMPACT_V]) = (0.05, 0.0);
+    d.set_continuous_states(&s).expect("takes them");
+    assert!(matches!(
+        d.event(&held(-30.0)),
+        Event::Impact { rests: true, .. }
+    ));
+    d.continuous_states()
+}
+
 fn fundamental() -> (f64, f64) {
     let (g, rho, r) = (9.81, 1000.0, H / A);
     let pi = std::f64::consts::PI;
@@ -216,14 +228,7 @@ fn a_tracked_amplitudes_tangent_is_its_change() {
                     *v = 0.004 * (k as f64 - 1.5);
                 }
                 if rest {
-                    // Pressed onto the wall +d/2 (the base accelerating towards -x), at rest.
-                    (s[IMPACT_Z], s[IMPACT_V]) = (0.05, 0.0);
-                    d.set_continuous_states(&s).expect("takes them");
-                    assert!(matches!(
-                        d.event(&held(-30.0)),
-                        Event::Impact { rests: true, .. }
-                    ));
-                    s = d.continuous_states();
+                    s = rest_on_the_wall(&mut d, s);
                 }
                 // Mid-way filters of base motion about 3 mm at 5 rad/s (the mean squares of
                 // its velocity and acceleration, 1.1e-4 and 2.8e-3 when settled).
@@ -320,14 +325,7 @@ fn every_outputs_tangent_is_its_change() {
         let mut s = d.continuous_states();
         s[..6].copy_from_slice(&[0.02, -0.05, 0.4, 0.1, 0.03, 0.2]);
         if rest {
-            // Pressed onto the wall +d/2 (the base accelerating towards -x), at rest there.
-            (s[IMPACT_Z], s[IMPACT_V]) = (0.05, 0.0);
-            d.set_continuous_states(&s).expect("takes them");
-            assert!(matches!(
-                d.event(&held(-30.0)),
-                Event::Impact { rests: true, .. }
-            ));
-            s = d.continuous_states();
+            s = rest_on_the_wall(&mut d, s);
         }
         d.set_continuous_states(&s).expect("takes them");
         let a = -0.6;
