@@ -104,6 +104,15 @@ fn harmonic_steps(w: f64, amplitude: f64, count: u32) -> Steps {
         .collect()
 }
 
+/// The input a0 + a1 s + a2 s^2/2 over a step.
+fn polynomial(a: &[f64; 3]) -> Inputs {
+    Inputs {
+        a: a[0],
+        a_derivatives: [a[1], a[2]],
+        ..Inputs::default()
+    }
+}
+
 /// Run `p` over `steps` and compare every output and rate with the reference of `law`.
 fn compare_run(p: &StartValues, law: Law, tanks: f64, a_e: f64, steps: &Steps, what: &str) {
     let mut sim = damper(p);
@@ -174,11 +183,7 @@ fn compare_run(p: &StartValues, law: Law, tanks: f64, a_e: f64, steps: &Steps, w
     let mut t = 0.0;
     let mut v_before = v0;
     for (k, ((h, a), y)) in steps.iter().zip(&refs).enumerate() {
-        let inputs = Inputs {
-            a: a[0],
-            a_derivatives: [a[1], a[2]],
-            ..Inputs::default()
-        };
+        let inputs = polynomial(a);
         sim.step(t, *h, &inputs).expect("step");
         t += h;
         let v = y[1];
@@ -291,11 +296,7 @@ fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
     for (x0, v0, h, a) in cases {
         let q = p.clone().with(vr::SLOSH_X0, x0).with(vr::SLOSH_V0, v0);
         let mut sim = damper(&q);
-        let inputs = Inputs {
-            a: a[0],
-            a_derivatives: [a[1], a[2]],
-            ..Inputs::default()
-        };
+        let inputs = polynomial(&a);
         let report = sim.step(0.0, h, &inputs).expect("step");
         // The largest hardening over the step, from the reference trajectory.
         let n = 400;
@@ -365,11 +366,7 @@ fn nonlinear_error_is_a_small_multiple_of_the_tolerance_at_half_the_tank() {
     let mut sim = damper(&p);
     let (mut t, mut err, mut largest) = (0.0, 0.0_f64, x0.abs());
     for ((h, a), y) in steps.iter().zip(&refs) {
-        let inputs = Inputs {
-            a: a[0],
-            a_derivatives: [a[1], a[2]],
-            ..Inputs::default()
-        };
+        let inputs = polynomial(a);
         sim.step(t, *h, &inputs).expect("step");
         t += h;
         err = err.max((sim.output(Output::X, &inputs) - y[0]).abs());

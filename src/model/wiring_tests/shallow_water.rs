@@ -8,6 +8,19 @@ use super::*;
 
 const SHALLOW_WATER: f64 = 5.0;
 
+/// ShallowWater in `tanks` tanks with a constant `zeta`, a fixed amplitude, from the
+/// fundamental mode (x0, v0).
+fn free_decay(tanks: f64, zeta: f64, x0: f64, v0: f64) -> StartValues {
+    StartValues::default()
+        .with(vr::MODEL, SHALLOW_WATER)
+        .with(vr::TANKS, tanks)
+        .with(vr::DAMPING, CONSTANT)
+        .with(vr::ZETA, zeta)
+        .with(vr::AMPLITUDE, FIXED)
+        .with(vr::SLOSH_X0, x0)
+        .with(vr::SLOSH_V0, v0)
+}
+
 /// Free decay of a small fundamental-mode slosh (the waves 0.8 % of the depth): slosh.x,
 /// slosh.v, force against the linear mode to 1 % of their largest values (the scheme's
 /// dispersion and diffusion at 150 cells, the waves' nonlinearity: 0.35 % seen), energy and
@@ -17,15 +30,7 @@ const SHALLOW_WATER: f64 = 5.0;
 fn shallow_water_small_slosh_is_the_linear_mode() {
     let tanks = 2.0;
     let (zeta, x0, v0) = (0.03, 0.0005, 0.002);
-    let p = StartValues::default()
-        .with(vr::MODEL, SHALLOW_WATER)
-        .with(vr::TANKS, tanks)
-        .with(vr::DAMPING, CONSTANT)
-        .with(vr::ZETA, zeta)
-        .with(vr::AMPLITUDE, FIXED)
-        .with(vr::A_E, 0.002)
-        .with(vr::SLOSH_X0, x0)
-        .with(vr::SLOSH_V0, v0);
+    let p = free_decay(tanks, zeta, x0, v0).with(vr::A_E, 0.002);
     let mut sim = damper(&p);
     let (m1, w) = natural(1);
     let (mass, liquid) = (m1 * tanks, liquid() * tanks);
@@ -128,17 +133,10 @@ fn shallow_water_small_slosh_is_the_linear_mode() {
 #[test]
 fn shallow_water_screens_dissipate_what_their_law_says() {
     let (tanks, zeta, x0, loss) = (2.0, 0.002, 0.001, 2.6);
-    let p = StartValues::default()
-        .with(vr::MODEL, SHALLOW_WATER)
-        .with(vr::TANKS, tanks)
-        .with(vr::DAMPING, CONSTANT)
-        .with(vr::ZETA, zeta)
-        .with(vr::AMPLITUDE, FIXED)
+    let p = free_decay(tanks, zeta, x0, 0.0)
         .with(vr::SWE_CELLS, 40.0)
         .with(vr::SCREENS_COUNT, 2.0)
-        .with(vr::SCREENS_LOSS, loss)
-        .with(vr::SLOSH_X0, x0)
-        .with(vr::SLOSH_V0, 0.0);
+        .with(vr::SCREENS_LOSS, loss);
     let mut sim = damper(&p);
     let (m1, w) = natural(1);
     // Two screens evenly spaced, at a/3 and 2a/3: sum |sin(pi x_j/a)|^3 = 2 (sqrt(3)/2)^3.
