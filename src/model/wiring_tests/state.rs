@@ -361,3 +361,25 @@ fn rejected_shallow_water_substeps_are_counted_and_cost_their_evaluations() {
     assert!(stats.rejected > 0 && stats.accepted > 1, "{stats:?}");
     assert_eq!(stats.evaluations, 10 * (stats.accepted + stats.rejected));
 }
+
+/// The number saved beside the pinned state layout (S^2's impact impulse): a model without
+/// impacts carries 0 and refuses any other (a snapshot of another model, or corrupted), and
+/// S^2 takes any finite impulse back and refuses a non-finite one.
+#[test]
+fn only_the_slamming_model_takes_an_impact_impulse_back() {
+    // 5: ShallowWater.
+    for model in [LINEAR, NONLINEAR, AUTO, 5.0] {
+        let mut sim = damper(&StartValues::default().with(vr::MODEL, model));
+        assert_eq!(sim.extra(), 0.0, "model {model}");
+        assert_eq!(sim.load_extra(0.0), Ok(()), "model {model}");
+        let refused = sim.load_extra(1e-3).expect_err("an impulse refused");
+        assert!(
+            refused.contains("impact impulse"),
+            "model {model}: {refused}"
+        );
+    }
+    let mut sim = damper(&StartValues::default().with(vr::MODEL, SLAMMING));
+    assert_eq!(sim.load_extra(1e-3), Ok(()));
+    assert_eq!(sim.extra(), 1e-3);
+    assert!(sim.load_extra(f64::NAN).is_err());
+}
