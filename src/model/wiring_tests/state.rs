@@ -383,3 +383,52 @@ fn only_the_slamming_model_takes_an_impact_impulse_back() {
     assert_eq!(sim.extra(), 1e-3);
     assert!(sim.load_extra(f64::NAN).is_err());
 }
+
+/// A jump dv of the tank's velocity (Model Exchange's impulse from the host): the liquid keeps
+/// its absolute velocity, so every velocity relative to the tank (slosh.v and the linear
+/// modes' mode[n].v) drops by dv, nothing else moves, and energy.input takes the change of the
+/// stored energy, which is sum_n m_n ((v_n - dv)^2 - v_n^2)/2 with Eq 2.1's modal masses.
+#[test]
+fn a_base_velocity_jump_shifts_every_relative_velocity() {
+    use crate::model::continuous::{BANK, ENERGY_INPUT};
+    let (x0, v0, dv) = (0.01, 0.02, 0.05);
+    for (model, modes) in [(LINEAR, 3u32), (NONLINEAR, 1)] {
+        let p = StartValues::default()
+            .with(vr::MODEL, model)
+            .with(vr::MODES, f64::from(modes))
+            .with(vr::SLOSH_X0, x0)
+            .with(vr::SLOSH_V0, v0);
+        let mut sim = damper(&p);
+        let none = Inputs::default();
+        let (before, stored) = (
+            sim.continuous_states(),
+            sim.output(Output::EnergyStored, &none),
+        );
+        assert_eq!(sim.base_velocity_jump(dv), Ok(true));
+        let after = sim.continuous_states();
+        let mut velocities = vec![1];
+        velocities.extend((1..modes as usize).map(|k| BANK + 2 * k - 1));
+        let mut want = 0.5 * natural(1).0 * ((v0 - dv).powi(2) - v0 * v0);
+        for n in 2..=modes {
+            want += 0.5 * natural(n).0 * dv * dv;
+        }
+        let gained = sim.output(Output::EnergyStored, &none) - stored;
+        assert!(
+            (gained - want).abs() < 1e-9 * want.abs(),
+            "model {model}: {gained} for {want}"
+        );
+        for (k, (b, a)) in before.iter().zip(&after).enumerate() {
+            let moved = if velocities.contains(&k) {
+                -dv
+            } else if k == ENERGY_INPUT {
+                want
+            } else {
+                0.0
+            };
+            assert!(
+                (a - b - moved).abs() < 1e-12,
+                "model {model}, state {k}: {b} to {a}"
+            );
+        }
+    }
+}
