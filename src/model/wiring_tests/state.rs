@@ -432,3 +432,17 @@ fn a_base_velocity_jump_shifts_every_relative_velocity() {
         }
     }
 }
+
+/// An enumeration's value that is no item of it is refused with the variable's name
+/// (FMU.md's: model, solver).
+#[test]
+fn an_enumeration_out_of_range_is_named() {
+    for (vr, name) in [(vr::MODEL, "model"), (vr::SOLVER, "solver")] {
+        let p = StartValues::default().with(vr, 99.0);
+        let refused = Damper::configure(&p).map(|_| ()).expect_err("99 refused");
+        assert!(
+            refused.contains(&format!("99 is no item of '{name}'")),
+            "{refused}"
+        );
+    }
+}
