@@ -104,6 +104,15 @@ fn harmonic_steps(w: f64, amplitude: f64, count: u32) -> Steps {
         .collect()
 }
 
+/// The input a0 + a1 s + a2 s^2/2 over a step.
+fn polynomial(a: &[f64; 3]) -> Inputs {
+    Inputs {
+        a: a[0],
+        a_derivatives: [a[1], a[2]],
+        ..Inputs::default()
+    }
+}
+
 /// Run `p` over `steps` and compare every output and rate with the reference of `law`.
 fn compare_run(p: &StartValues, law: Law, tanks: f64, a_e: f64, steps: &Steps, what: &str) {
     let mut sim = damper(p);
@@ -174,11 +183,7 @@ fn compare_run(p: &StartValues, law: Law, tanks: f64, a_e: f64, steps: &Steps, w
     let mut t = 0.0;
     let mut v_before = v0;
     for (k, ((h, a), y)) in steps.iter().zip(&refs).enumerate() {
-        let inputs = Inputs {
-            a: a[0],
-            a_derivatives: [a[1], a[2]],
-            ..Inputs::default()
-        };
+        let inputs = polynomial(a);
         sim.step(t, *h, &inputs).expect("step");
         t += h;
         let v = y[1];
@@ -291,11 +296,7 @@ fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
     for (x0, v0, h, a) in cases {
         let q = p.clone().with(vr::SLOSH_X0, x0).with(vr::SLOSH_V0, v0);
         let mut sim = damper(&q);
-        let inputs = Inputs {
-            a: a[0],
-            a_derivatives: [a[1], a[2]],
-            ..Inputs::default()
-        };
+        let inputs = polynomial(&a);
         let report = sim.step(0.0, h, &inputs).expect("step");
         // The largest hardening over the step, from the reference trajectory.
         let n = 400;
@@ -337,4 +338,111 @@ fn auto_takes_the_linear_step_only_where_the_hardening_is_small() {
             "{what}: force {force}"
         );
     }
+}
+
+/// Model = Nonlinear's error control: the adaptive solver holds its error to solver.tolerance
+/// times the scale half a tank length (docs/MODEL.md: the error norm rtol (a/2 + |x|)), so at a
+/// moderate tolerance its error over a whole run of free sloshing (steps of 1 s, many solver
+/// steps each) against the tiny-step RK4 must be a small multiple of rtol (a/2 + |x|max), and
+/// not far below it (the test would then not see the scale).
+#[test]
+fn nonlinear_error_is_a_small_multiple_of_the_tolerance_at_half_the_tank() {
+    let w = natural(1).1;
+    let (a_e, rtol) = (0.001, 1e-6);
+    let law = Law {
+        w,
+        phi: 1.0,
+        eta: 2.0,
+    };
+    let c = 2.0 * nsd_zeta(a_e) * w;
+    let (x0, v0) = (0.05, 0.0);
+    // Free sloshing in steps of 1 s (about one period): the solver takes many steps in each.
+    let steps: Steps = vec![(1.0, [0.0; 3]); 8];
+    let refs = reference(law, c, x0, v0, &steps, 2000, 1e-6);
+    let p = nonlinear_parameters(NONLINEAR, 2.0, 1.0, a_e)
+        .with(vr::SOLVER_TOLERANCE, rtol)
+        .with(vr::SLOSH_X0, x0)
+        .with(vr::SLOSH_V0, v0);
+    let mut sim = damper(&p);
+    let (mut t, mut err, mut largest) = (0.0, 0.0_f64, x0.abs());
+    for ((h, a), y) in steps.iter().zip(&refs) {
+        let inputs = polynomial(a);
+        sim.step(t, *h, &inputs).expect("step");
+        t += h;
+        err = err.max((sim.output(Output::X, &inputs) - y[0]).abs());
+        largest = largest.max(y[0].abs());
+    }
+    let scale = rtol * (0.5 * A + largest);
+    // Measured: 0.92 rtol (a/2 + |x|max); with the scale a/2 made 2 m (16 times looser), 8.1.
+    assert!(
+        err <= 2.0 * scale,
+        "error {err:e} for rtol (a/2 + |x|) = {scale:e}"
+    );
+    assert!(
+        err >= 0.05 * scale,
+        "error {err:e}: the run does not exercise the error control"
+    );
+}
+
+/// Model = Auto in a long tank (a = 10 m, h = 1 m: omega_f 0.97 rad/s, where the bound's
+/// static-deflection term 2/omega_f^2 is larger than h/omega_f's step terms): near-resonant
+/// forcing grows the slosh through the threshold's amplitude (hardening 1e-6 at |x| = 5 mm),
+/// so Auto takes the exact linear step early and the integrator late; every step is the
+/// Nonlinear model's (DOP853 at 1e-12) to a small multiple of the threshold (1.3e-9 of the
+/// 1.6e-7 allowed seen; 53 steps of 300 linear).
+#[test]
+fn auto_in_a_long_tank_is_the_nonlinear_model() {
+    let (a, depth, threshold) = (10.0, 1.0, 1e-6);
+    let w = (G * PI * (PI * depth / a).tanh() / a).sqrt();
+    let long = |model| {
+        nonlinear_parameters(model, 2.0, 1.0, 0.0)
+            .with(vr::TANK_LENGTH, a)
+            .with(vr::TANK_BREADTH, 1.0)
+            .with(vr::TANK_DEPTH, depth)
+            .with(vr::DAMPING, CONSTANT)
+            .with(vr::ZETA, 0.02)
+            .with(vr::AUTO_THRESHOLD, threshold)
+            .with(vr::SLOSH_X0, 0.001)
+            .with(vr::SLOSH_V0, 0.0)
+    };
+    let (mut auto, mut nonlinear) = (damper(&long(AUTO)), damper(&long(NONLINEAR)));
+    let (h, d) = (0.1, 1.5e-3);
+    let (mut t, mut linear, mut refused) = (0.0, 0, 0);
+    let (mut err, mut largest) = (0.0_f64, 0.0_f64);
+    for _ in 0..300 {
+        let (s, c) = (w * t).sin_cos();
+        let w2 = w * w;
+        let inputs = Inputs {
+            a: -d * w2 * s,
+            a_derivatives: [-d * w2 * w * c, d * w2 * w2 * s],
+            ..Inputs::default()
+        };
+        let before = nonlinear.output(Output::X, &inputs);
+        let report = auto.step(t, h, &inputs).expect("Auto");
+        nonlinear.step(t, h, &inputs).expect("Nonlinear");
+        t += h;
+        let x = nonlinear.output(Output::X, &inputs);
+        if report.stats.evaluations == 0 {
+            linear += 1;
+            // The hardening phi (2x/a)^2 at both ends of a linear step below the threshold.
+            let hardening = (2.0 * before.abs().max(x.abs()) / a).powi(2);
+            assert!(hardening < threshold, "linear step at t {t}: {hardening:e}");
+        } else {
+            refused += 1;
+        }
+        err = err.max((auto.output(Output::X, &inputs) - x).abs());
+        largest = largest.max(x.abs());
+    }
+    assert!(
+        linear > 10 && refused > 10,
+        "{linear} linear, {refused} not"
+    );
+    assert!(
+        largest > 0.01,
+        "the slosh {largest:e} m stays below the threshold's"
+    );
+    assert!(
+        err <= 10.0 * threshold * largest,
+        "x off by {err:e} of {largest:e}"
+    );
 }

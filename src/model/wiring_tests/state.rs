@@ -361,3 +361,88 @@ fn rejected_shallow_water_substeps_are_counted_and_cost_their_evaluations() {
     assert!(stats.rejected > 0 && stats.accepted > 1, "{stats:?}");
     assert_eq!(stats.evaluations, 10 * (stats.accepted + stats.rejected));
 }
+
+/// The number saved beside the pinned state layout (S^2's impact impulse): a model without
+/// impacts carries 0 and refuses any other (a snapshot of another model, or corrupted), and
+/// S^2 takes any finite impulse back and refuses a non-finite one.
+#[test]
+fn only_the_slamming_model_takes_an_impact_impulse_back() {
+    // 5: ShallowWater.
+    for model in [LINEAR, NONLINEAR, AUTO, 5.0] {
+        let mut sim = damper(&StartValues::default().with(vr::MODEL, model));
+        assert_eq!(sim.extra(), 0.0, "model {model}");
+        assert_eq!(sim.load_extra(0.0), Ok(()), "model {model}");
+        let refused = sim.load_extra(1e-3).expect_err("an impulse refused");
+        assert!(
+            refused.contains("impact impulse"),
+            "model {model}: {refused}"
+        );
+    }
+    let mut sim = damper(&StartValues::default().with(vr::MODEL, SLAMMING));
+    assert_eq!(sim.load_extra(1e-3), Ok(()));
+    assert_eq!(sim.extra(), 1e-3);
+    assert!(sim.load_extra(f64::NAN).is_err());
+}
+
+/// A jump dv of the tank's velocity (Model Exchange's impulse from the host): the liquid keeps
+/// its absolute velocity, so every velocity relative to the tank (slosh.v and the linear
+/// modes' mode[n].v) drops by dv, nothing else moves, and energy.input takes the change of the
+/// stored energy, which is sum_n m_n ((v_n - dv)^2 - v_n^2)/2 with Eq 2.1's modal masses.
+#[test]
+fn a_base_velocity_jump_shifts_every_relative_velocity() {
+    use crate::model::continuous::{BANK, ENERGY_INPUT};
+    let (x0, v0, dv) = (0.01, 0.02, 0.05);
+    for (model, modes) in [(LINEAR, 3u32), (NONLINEAR, 1)] {
+        let p = StartValues::default()
+            .with(vr::MODEL, model)
+            .with(vr::MODES, f64::from(modes))
+            .with(vr::SLOSH_X0, x0)
+            .with(vr::SLOSH_V0, v0);
+        let mut sim = damper(&p);
+        let none = Inputs::default();
+        let (before, stored) = (
+            sim.continuous_states(),
+            sim.output(Output::EnergyStored, &none),
+        );
+        assert_eq!(sim.base_velocity_jump(dv), Ok(true));
+        let after = sim.continuous_states();
+        let mut velocities = vec![1];
+        velocities.extend((1..modes as usize).map(|k| BANK + 2 * k - 1));
+        let mut want = 0.5 * natural(1).0 * ((v0 - dv).powi(2) - v0 * v0);
+        for n in 2..=modes {
+            want += 0.5 * natural(n).0 * dv * dv;
+        }
+        let gained = sim.output(Output::EnergyStored, &none) - stored;
+        assert!(
+            (gained - want).abs() < 1e-9 * want.abs(),
+            "model {model}: {gained} for {want}"
+        );
+        for (k, (b, a)) in before.iter().zip(&after).enumerate() {
+            let moved = if velocities.contains(&k) {
+                -dv
+            } else if k == ENERGY_INPUT {
+                want
+            } else {
+                0.0
+            };
+            assert!(
+                (a - b - moved).abs() < 1e-12,
+                "model {model}, state {k}: {b} to {a}"
+            );
+        }
+    }
+}
+
+/// An enumeration's value that is no item of it is refused with the variable's name
+/// (FMU.md's: model, solver).
+#[test]
+fn an_enumeration_out_of_range_is_named() {
+    for (vr, name) in [(vr::MODEL, "model"), (vr::SOLVER, "solver")] {
+        let p = StartValues::default().with(vr, 99.0);
+        let refused = Damper::configure(&p).map(|_| ()).expect_err("99 refused");
+        assert!(
+            refused.contains(&format!("99 is no item of '{name}'")),
+            "{refused}"
+        );
+    }
+}
