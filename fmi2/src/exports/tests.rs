@@ -155,9 +155,19 @@ impl log::Log for Capture {
 }
 
 /// The messages logged so far for the instance `name`, with their levels.
-pub(super) fn logs_of(name: &str) -> Vec<(log::Level, String)> {
+pub(crate) fn logs_of(name: &str) -> Vec<(log::Level, String)> {
     let records = RECORDS.lock().unwrap();
     records.get(name).cloned().unwrap_or_default()
+}
+
+/// Route the host's log (fmi-sys's C logger, through the `log` crate) into [`RECORDS`]: once
+/// per test process, for every test module that reads it with [`logs_of`].
+pub(crate) fn capture_logs() {
+    static LOGGER: Once = Once::new();
+    LOGGER.call_once(|| {
+        log::set_logger(&Capture).unwrap();
+        log::set_max_level(log::LevelFilter::Trace);
+    });
 }
 
 /// An instance of Testy, named `name` (each test its own), logging through fmi-sys's C logger
@@ -169,11 +179,7 @@ pub(super) struct Host {
 
 impl Host {
     pub(super) fn new(name: &str, tolerance: Option<f64>) -> Self {
-        static LOGGER: Once = Once::new();
-        LOGGER.call_once(|| {
-            log::set_logger(&Capture).unwrap();
-            log::set_max_level(log::LevelFilter::Trace);
-        });
+        capture_logs();
         let callbacks = Box::new(fmi2CallbackFunctions {
             logger: Some(fmi_sys::fmi2::logger::callback_logger_handler),
             allocateMemory: None,
