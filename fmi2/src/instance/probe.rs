@@ -11,7 +11,7 @@ use fmi_sys::fmi2::*;
 
 use crate::continuous::Continuous;
 use crate::description::{Causality, Table, VarType, Variability, Variable, log_category};
-use crate::exports::tests::{capture_logs, logs_of};
+use crate::exports::tests::{instantiate, logs_of};
 use crate::exports::*;
 use crate::frame::{self, Reader};
 use crate::instance::Instance;
@@ -230,29 +230,7 @@ impl Fmu {
     /// A new instance `name` (each test its own) of the interface `kind`, with fmi2Instantiate's
     /// loggingOn.
     pub(super) fn new(name: &str, kind: fmi2Type, logging_on: bool) -> Self {
-        capture_logs();
-        let callbacks = Box::new(fmi2CallbackFunctions {
-            logger: Some(fmi_sys::fmi2::logger::callback_logger_handler),
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: std::ptr::null_mut(),
-        });
-        let c_name = CString::new(name).unwrap();
-        let guid = CString::new(TABLE.guid).unwrap();
-        // SAFETY: valid strings and callbacks, which outlive the instance.
-        let c = unsafe {
-            fmi2Instantiate::<Probe>(
-                c_name.as_ptr(),
-                kind,
-                guid.as_ptr(),
-                std::ptr::null(),
-                &*callbacks,
-                0,
-                i32::from(logging_on),
-            )
-        };
-        assert!(!c.is_null());
+        let (c, callbacks) = instantiate::<Probe>(name, kind, logging_on);
         Fmu {
             c,
             name: name.into(),
