@@ -276,6 +276,10 @@ fn do_step_takes_the_hosts_rounding_and_no_more() {
             assert_eq!(fmu.last_successful_time(), end, "{name}");
         }
     }
+    // "Up to": at 0 s (where the difference is exact) a point off by the allowance itself.
+    let fmu = running("probe-slack-exact", 0.0, None);
+    let allowance = 1e-9 * 1.0 + 1e-6 * 100.0;
+    assert_eq!(fmu.step(allowance, 100.0), OK);
     // The stop time: a last step that ends past it by less than the allowance ends there.
     for (stop, h, allowance) in [(1e6, 1.0, 1e-3), (100.0, 100.0, 1e-4)] {
         for (factor, expected) in [(0.5, OK), (2.0, ERROR)] {
