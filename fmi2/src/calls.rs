@@ -222,6 +222,10 @@ pub const GET_CONTINUOUS_STATES: Call = call("fmi2GetContinuousStates", allow::S
 pub const GET_NOMINALS_OF_CONTINUOUS_STATES: Call =
     call("fmi2GetNominalsOfContinuousStates", allow::STATES);
 
+/// The table against the FMI 2.0 standard's tables, and the hints against the table.
+#[cfg(test)]
+mod standard_tests;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -380,3 +380,8 @@ fn finite_values<S: Slave>(context: &Context, slave: &S) -> Result<(), String> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod probe;
+#[cfg(test)]
+mod tests;

@@ -125,4 +125,4 @@ fn handed_out_finite(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -155,9 +155,53 @@ impl log::Log for Capture {
 }
 
 /// The messages logged so far for the instance `name`, with their levels.
-pub(super) fn logs_of(name: &str) -> Vec<(log::Level, String)> {
+pub(crate) fn logs_of(name: &str) -> Vec<(log::Level, String)> {
     let records = RECORDS.lock().unwrap();
     records.get(name).cloned().unwrap_or_default()
+}
+
+/// Route the host's log (fmi-sys's C logger, through the `log` crate) into [`RECORDS`]: once
+/// per test process, for every test module that reads it with [`logs_of`].
+pub(crate) fn capture_logs() {
+    static LOGGER: Once = Once::new();
+    LOGGER.call_once(|| {
+        log::set_logger(&Capture).unwrap();
+        log::set_max_level(log::LevelFilter::Trace);
+    });
+}
+
+/// An instance of `S` named `name` made by fmi2Instantiate for the interface `kind` with
+/// `logging_on`, logging through fmi-sys's C logger into [`RECORDS`]; with the callbacks, which
+/// must outlive it.
+pub(crate) fn instantiate<S: Slave>(
+    name: &str,
+    kind: fmi2Type,
+    logging_on: bool,
+) -> (fmi2Component, Box<fmi2CallbackFunctions>) {
+    capture_logs();
+    let callbacks = Box::new(fmi2CallbackFunctions {
+        logger: Some(fmi_sys::fmi2::logger::callback_logger_handler),
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: std::ptr::null_mut(),
+    });
+    let name = CString::new(name).unwrap();
+    let guid = CString::new(S::TABLE.guid).unwrap();
+    // SAFETY: valid strings and callbacks, which outlive the instance.
+    let c = unsafe {
+        fmi2Instantiate::<S>(
+            name.as_ptr(),
+            kind,
+            guid.as_ptr(),
+            std::ptr::null(),
+            &*callbacks,
+            0,
+            i32::from(logging_on),
+        )
+    };
+    assert!(!c.is_null());
+    (c, callbacks)
 }
 
 /// An instance of Testy, named `name` (each test its own), logging through fmi-sys's C logger
@@ -169,33 +213,7 @@ pub(super) struct Host {
 
 impl Host {
     pub(super) fn new(name: &str, tolerance: Option<f64>) -> Self {
-        static LOGGER: Once = Once::new();
-        LOGGER.call_once(|| {
-            log::set_logger(&Capture).unwrap();
-            log::set_max_level(log::LevelFilter::Trace);
-        });
-        let callbacks = Box::new(fmi2CallbackFunctions {
-            logger: Some(fmi_sys::fmi2::logger::callback_logger_handler),
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: std::ptr::null_mut(),
-        });
-        let name = CString::new(name).unwrap();
-        let guid = CString::new(TABLE.guid).unwrap();
-        // SAFETY: valid strings and callbacks, which outlive the instance.
-        let c = unsafe {
-            fmi2Instantiate::<Testy>(
-                name.as_ptr(),
-                fmi2Type_fmi2CoSimulation,
-                guid.as_ptr(),
-                std::ptr::null(),
-                &*callbacks,
-                0,
-                0,
-            )
-        };
-        assert!(!c.is_null());
+        let (c, callbacks) = instantiate::<Testy>(name, fmi2Type_fmi2CoSimulation, false);
         let host = Host {
             c,
             _callbacks: callbacks,
