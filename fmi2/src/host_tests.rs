@@ -44,6 +44,10 @@ fn null_misaligned_and_impossible_arrays_are_refused() {
     let odd = unsafe { words.as_ptr().cast::<u8>().add(1) };
     let misaligned = odd.cast::<f64>();
     for n in [1, 2, 3] {
+        // Asked first, so that a wrong answer fails here, not in the slice's own checks.
+        assert!(!valid_array(null, n));
+        assert!(!valid_array(misaligned, n));
+        assert!(valid_array(odd, n));
         // SAFETY: each is refused before any read.
         unsafe {
             let why = host_slice(null, n, CALL, "vr").expect_err("null");
@@ -54,9 +58,6 @@ fn null_misaligned_and_impossible_arrays_are_refused() {
                 host_slice_mut(misaligned.cast_mut(), n, CALL, "out").expect_err("misaligned");
             assert_eq!(*why.message, refusal("out", n));
         }
-        assert!(!valid_array(null, n));
-        assert!(!valid_array(misaligned, n));
-        assert!(valid_array(odd, n));
     }
     // SAFETY: refused before any write.
     let why = unsafe { host_ref(std::ptr::null_mut::<i32>(), CALL, "size") }.expect_err("null");
