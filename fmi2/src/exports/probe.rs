@@ -232,14 +232,12 @@ impl<const MARK: u64> Slave for Probe<MARK> {
         function: &str,
         from: fn(T) -> f64,
     ) -> Reply {
-        let mut checked = Vec::with_capacity(vrs.len());
+        // All or nothing: set on a copy, kept only if every value was taken.
+        let mut next = self.values.clone();
         for (&r, &v) in vrs.iter().zip(values) {
-            let v = from(v);
-            checked.push((TABLE.settable(context.phase, r, v, ty, function)?, v));
+            next[TABLE.settable(context.phase, r, from(v), ty, function)?] = from(v);
         }
-        for (i, v) in checked {
-            self.values[i] = v;
-        }
+        self.values = next;
         Ok(Status::Ok)
     }
     /// u alone, the per-step input: any finite value in every phase that allows a set.
