@@ -99,3 +99,7 @@ fn not_offered(function: &str) -> Refusal {
         "{function}: this FMU does not offer Model Exchange"
     ))
 }
+
+#[cfg(test)]
+#[path = "continuous_tests.rs"]
+mod tests;

@@ -328,3 +328,7 @@ impl Variable {
         None
     }
 }
+
+#[cfg(test)]
+#[path = "description_tests.rs"]
+mod tests;

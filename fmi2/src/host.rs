@@ -85,3 +85,7 @@ pub unsafe fn host_text(ptr: fmi2String) -> Option<String> {
     let text = unsafe { CStr::from_ptr(ptr) }.to_string_lossy();
     Some(text.chars().take(256).collect())
 }
+
+#[cfg(test)]
+#[path = "host_tests.rs"]
+mod tests;

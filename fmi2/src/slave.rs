@@ -120,3 +120,7 @@ pub trait Slave: Continuous {
     /// A slave from its part of a saved state (`context` and `flag` already read and checked).
     fn load(context: &Context, flag: bool, part: &mut Reader) -> Result<Self, String>;
 }
+
+#[cfg(test)]
+#[path = "slave_tests.rs"]
+mod tests;

@@ -249,3 +249,7 @@ pub unsafe fn fmi2GetDirectionalDerivative<S: Slave>(
         Ok(status)
     })
 }
+
+#[cfg(test)]
+#[path = "me_tests.rs"]
+mod tests;

@@ -70,14 +70,19 @@ fn report<S: Slave>(inst: &mut Instance<S>, call: &Call, reply: Reply) -> fmi2St
             status as fmi2Status
         }
         Err(Refusal { status, message }) => {
-            let category = if status >= Status::Error {
-                log_category::LOG_STATUS_ERROR
-            } else {
-                log_category::LOG_STATUS_WARNING
-            };
-            inst.log(status, category, &message);
+            inst.log(status, status_category(status), &message);
             status as fmi2Status
         }
+    }
+}
+
+/// The log category of a refusal with `status`: errors (and fatal errors) to logStatusError,
+/// the rest to logStatusWarning (the model descriptions' LogCategories).
+fn status_category(status: Status) -> &'static str {
+    if status >= Status::Error {
+        log_category::LOG_STATUS_ERROR
+    } else {
+        log_category::LOG_STATUS_WARNING
     }
 }
 
@@ -124,5 +129,9 @@ fn handed_out_finite(
     }
 }
 
+#[cfg(test)]
+mod guard_tests;
+#[cfg(test)]
+pub(crate) mod probe;
 #[cfg(test)]
 pub(crate) mod tests;

@@ -223,3 +223,7 @@ mod tests {
         assert_eq!(logs_of(name).len(), 4);
     }
 }
+
+#[cfg(test)]
+#[path = "state_tests.rs"]
+mod mark_tests;

@@ -371,3 +371,7 @@ pub unsafe fn fmi2GetRealOutputDerivatives<S: Slave>(
         Ok(status)
     })
 }
+
+#[cfg(test)]
+#[path = "values_tests.rs"]
+mod tests;

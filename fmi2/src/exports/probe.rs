@@ -1,0 +1,396 @@
+//! Probe: a slave of the tests' own with a variable table of every kind the shared layer checks
+//! (a fixed and a tunable parameter with bounds, an Integer, an Enumeration, a calculated
+//! parameter, a continuous and a discrete input, a Boolean, an output, a local), a quick path
+//! for some of them, first-order input and output derivatives, and two continuous states for
+//! Model Exchange. Its answers are simple enough to work out by hand:
+//!
+//! - y = k u, its derivative k du (du: u's input derivative), g = 2 k, l = c;
+//! - Model Exchange: x' = (x1, -k x0) (an oscillator), one event indicator x0;
+//! - it keeps the defaults of `Slave::flag` and of `Continuous`'s nominals, completed step,
+//!   event update and directional derivatives.
+//!
+//! `MARK` is a parameter so that the state boxes' marks can be tested for more than one FMU.
+//! [`Rig`] drives an instance of it (or of any slave) through the exports, as a host does.
+
+use std::ffi::CString;
+use std::marker::PhantomData;
+use std::sync::Once;
+
+use fmi_sys::fmi2::*;
+
+use super::tests::Host;
+use super::*;
+use crate::continuous::Continuous;
+use crate::description::{Causality, Table, VarType, Variability, Variable};
+use crate::frame::{Reader, put_f64, put_f64_list};
+use crate::slave::Context;
+
+pub(crate) const K: u32 = 10;
+pub(crate) const C: u32 = 11;
+pub(crate) const N: u32 = 12;
+pub(crate) const MODE: u32 = 13;
+pub(crate) const G: u32 = 14;
+pub(crate) const U: u32 = 20;
+pub(crate) const JUMP: u32 = 21;
+pub(crate) const ON: u32 = 22;
+pub(crate) const Y: u32 = 30;
+pub(crate) const L: u32 = 31;
+
+#[allow(clippy::too_many_arguments)]
+const fn var(
+    name: &'static str,
+    vr: u32,
+    ty: VarType,
+    causality: Causality,
+    variability: Variability,
+    start: Option<f64>,
+    min: Option<f64>,
+    max: Option<f64>,
+) -> Variable {
+    Variable {
+        name,
+        vr,
+        ty,
+        causality,
+        variability,
+        start,
+        min,
+        max,
+        items: &[],
+        unit: "",
+        description: "",
+    }
+}
+
+use Causality::{CalculatedParameter, Input, Local, Output, Parameter};
+use VarType::{Boolean, Enumeration, Integer, Real};
+use Variability::{Continuous as Cont, Discrete, Fixed, Tunable};
+
+/// The variables, in an order that is not the value references' (position != vr).
+pub(crate) const VARIABLES: &[Variable] = &[
+    var(
+        "k",
+        K,
+        Real,
+        Parameter,
+        Fixed,
+        Some(2.0),
+        Some(0.5),
+        Some(4.0),
+    ),
+    var("c", C, Real, Parameter, Tunable, Some(0.1), Some(0.0), None),
+    var(
+        "n",
+        N,
+        Integer,
+        Parameter,
+        Fixed,
+        Some(3.0),
+        Some(1.0),
+        Some(10.0),
+    ),
+    Variable {
+        items: &[("A", 1), ("B", 2), ("C", 5)],
+        ..var(
+            "mode",
+            MODE,
+            Enumeration,
+            Parameter,
+            Fixed,
+            Some(2.0),
+            None,
+            None,
+        )
+    },
+    var("g", G, Real, CalculatedParameter, Fixed, None, None, None),
+    var("u", U, Real, Input, Cont, Some(0.0), None, None),
+    var("jump", JUMP, Real, Input, Discrete, Some(0.0), None, None),
+    var("on", ON, Boolean, Input, Discrete, Some(0.0), None, None),
+    var("y", Y, Real, Output, Cont, None, None, None),
+    var("l", L, Real, Local, Cont, None, None, None),
+];
+
+const VR_INDEX: [i32; 32] = {
+    let mut index = [-1; 32];
+    let mut i = 0;
+    while i < VARIABLES.len() {
+        index[VARIABLES[i].vr as usize] = i as i32;
+        i += 1;
+    }
+    index
+};
+
+pub(crate) static TABLE: Table = Table {
+    model_identifier: "Probe",
+    guid: "{probe}",
+    variables: VARIABLES,
+    vr_index: &VR_INDEX,
+    log_categories: &[
+        log_category::LOG_STATUS_ERROR,
+        log_category::LOG_STATUS_WARNING,
+        log_category::LOG_CALLS,
+    ],
+};
+
+/// Position in [`VARIABLES`] of `vr` (the tests' own lookup, not the table's).
+pub(crate) fn at(vr: u32) -> usize {
+    VARIABLES
+        .iter()
+        .position(|v| v.vr == vr)
+        .expect("a Probe variable")
+}
+
+pub(crate) struct Probe<const MARK: u64> {
+    /// The stored values by position (y, g and l are computed).
+    values: Vec<f64>,
+    /// u's input derivative.
+    du: f64,
+    x: [f64; 2],
+    /// The flag `load` was given (None: not loaded).
+    pub(crate) restored_flag: Option<bool>,
+}
+
+impl<const MARK: u64> Probe<MARK> {
+    fn value(&self, i: usize) -> f64 {
+        let v = |vr| self.values[at(vr)];
+        match VARIABLES[i].vr {
+            Y => v(K) * v(U),
+            G => 2.0 * v(K),
+            L => v(C),
+            _ => self.values[i],
+        }
+    }
+}
+
+impl<const MARK: u64> Continuous for Probe<MARK> {
+    const STATES: usize = 2;
+    const EVENT_INDICATORS: usize = 1;
+
+    fn offers_model_exchange(&self) -> Result<(), String> {
+        Ok(())
+    }
+    fn states(&self, x: &mut [f64]) -> Reply {
+        x.copy_from_slice(&self.x);
+        Ok(Status::Ok)
+    }
+    fn set_states(&mut self, _: &Context, x: &[f64]) -> Reply {
+        self.x.copy_from_slice(x);
+        Ok(Status::Ok)
+    }
+    fn derivatives(&self, _: &Context, dx: &mut [f64]) -> Reply {
+        dx.copy_from_slice(&[self.x[1], -self.values[at(K)] * self.x[0]]);
+        Ok(Status::Ok)
+    }
+    fn event_indicators(&self, _: &Context, out: &mut [f64]) -> Reply {
+        out[0] = self.x[0];
+        Ok(Status::Ok)
+    }
+}
+
+impl<const MARK: u64> Slave for Probe<MARK> {
+    const TABLE: &'static Table = &TABLE;
+    const MARK: u64 = MARK;
+    const STATE_TAG: [u8; 4] = *b"PRBs";
+    const STATE_VERSION: u16 = 1;
+
+    fn new() -> Self {
+        Probe {
+            values: VARIABLES.iter().map(|v| v.start.unwrap_or(0.0)).collect(),
+            du: 0.0,
+            x: [0.0; 2],
+            restored_flag: None,
+        }
+    }
+    fn initialise(&mut self, _: &Context) -> Result<Vec<String>, Refusal> {
+        Ok(Vec::new())
+    }
+    fn uninitialise(&mut self) {}
+    fn step(&mut self, _: &Context, _: f64, _: f64) -> Result<bool, Refusal> {
+        Ok(false)
+    }
+    fn get<T>(
+        &self,
+        _: &Context,
+        vrs: &[u32],
+        out: &mut [T],
+        ty: VarType,
+        function: &str,
+        to: fn(f64) -> T,
+    ) -> Reply {
+        for (slot, &r) in out.iter_mut().zip(vrs) {
+            let (i, _) = TABLE.typed_variable(r, ty, function)?;
+            *slot = to(self.value(i));
+        }
+        Ok(Status::Ok)
+    }
+    fn set<T: Copy>(
+        &mut self,
+        context: &Context,
+        vrs: &[u32],
+        values: &[T],
+        ty: VarType,
+        function: &str,
+        from: fn(T) -> f64,
+    ) -> Reply {
+        // All or nothing: set on a copy, kept only if every value was taken.
+        let mut next = self.values.clone();
+        for (&r, &v) in vrs.iter().zip(values) {
+            next[TABLE.settable(context.phase, r, from(v), ty, function)?] = from(v);
+        }
+        self.values = next;
+        Ok(Status::Ok)
+    }
+    /// u alone, the per-step input: any finite value in every phase that allows a set.
+    fn set_quietly(&mut self, r: u32, value: f64, ty: VarType) -> bool {
+        let take = r == U && ty == Real && value.is_finite();
+        if take {
+            self.values[at(U)] = value;
+        }
+        take
+    }
+    /// k and u as Reals, n as an Integer: stored values.
+    fn get_quietly(&self, r: u32, ty: VarType) -> Option<f64> {
+        match (r, ty) {
+            (K | U, Real) | (N, Integer) => Some(self.values[at(r)]),
+            _ => None,
+        }
+    }
+    fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Reply {
+        for ((&r, &order), &v) in vrs.iter().zip(orders).zip(values) {
+            TABLE.check_input_derivative(r, order, v, 1)?;
+        }
+        if let Some(&du) = values.last() {
+            self.du = du;
+        }
+        Ok(Status::Ok)
+    }
+    fn output_derivatives(
+        &self,
+        context: &Context,
+        vrs: &[u32],
+        orders: &[i32],
+        put: impl FnMut(usize, f64),
+    ) -> Reply {
+        let model = context.phase.initialised().then_some(self);
+        let output = |r: u32| (r == Y).then_some(());
+        let rate = |p: &Self, ()| p.values[at(K)] * p.du;
+        TABLE.first_output_derivatives(model, vrs, orders, output, rate, put)
+    }
+    fn save(&self, out: &mut Vec<u8>) {
+        put_f64_list(out, &self.values);
+        put_f64_list(out, &self.x);
+        put_f64(out, self.du);
+    }
+    fn load(_: &Context, flag: bool, part: &mut Reader) -> Result<Self, String> {
+        let values = part.f64_list()?;
+        let x = part.f64_list()?;
+        let du = part.f64()?;
+        let x: [f64; 2] = x.try_into().map_err(|_| "two states".to_string())?;
+        if values.len() != VARIABLES.len() {
+            return Err("one value per variable".into());
+        }
+        Ok(Probe {
+            values,
+            du,
+            x,
+            restored_flag: Some(flag),
+        })
+    }
+}
+
+/// The mark of the Probe most tests use.
+pub(crate) const MARK: u64 = 0x5052_4f42_4520_2020;
+pub(crate) type P = Probe<MARK>;
+
+/// The host's log goes to exports::tests' capture (one logger per process), which its
+/// hosts install: made once here for the tests that start with a Rig.
+fn capture_logs() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| drop(Host::new("capture-logs", None)));
+}
+
+/// An instance of `S` driven as a host drives it, logging through fmi-sys's C logger into
+/// exports::tests' capture under its `name` (each test its own).
+pub(crate) struct Rig<S: Slave> {
+    pub(crate) c: fmi2Component,
+    _callbacks: Box<fmi2CallbackFunctions>,
+    _slave: PhantomData<S>,
+}
+
+impl<S: Slave> Rig<S> {
+    /// Instantiated (`kind`: fmi2CoSimulation or fmi2ModelExchange), with logging on or off.
+    pub(crate) fn new(name: &str, kind: fmi2Type, logging: bool) -> Self {
+        capture_logs();
+        let callbacks = Box::new(fmi2CallbackFunctions {
+            logger: Some(fmi_sys::fmi2::logger::callback_logger_handler),
+            allocateMemory: None,
+            freeMemory: None,
+            stepFinished: None,
+            componentEnvironment: std::ptr::null_mut(),
+        });
+        let name = CString::new(name).expect("a test's name");
+        let guid = CString::new(S::TABLE.guid).expect("a GUID");
+        // SAFETY: valid strings and callbacks, which outlive the instance.
+        let c = unsafe {
+            fmi2Instantiate::<S>(
+                name.as_ptr(),
+                kind,
+                guid.as_ptr(),
+                std::ptr::null(),
+                &*callbacks,
+                0,
+                i32::from(logging),
+            )
+        };
+        assert!(!c.is_null());
+        Rig {
+            c,
+            _callbacks: callbacks,
+            _slave: PhantomData,
+        }
+    }
+
+    /// Instantiated, set up (no tolerance, start 0, no stop) and in initialisation mode.
+    pub(crate) fn in_initialisation(name: &str, kind: fmi2Type, logging: bool) -> Self {
+        let rig = Self::new(name, kind, logging);
+        // SAFETY: our live instance.
+        unsafe {
+            assert_eq!(
+                fmi2SetupExperiment::<S>(rig.c, 0, 0.0, 0.0, 0, 0.0),
+                fmi2Status_fmi2OK
+            );
+            assert_eq!(fmi2EnterInitializationMode::<S>(rig.c), fmi2Status_fmi2OK);
+        }
+        rig
+    }
+
+    /// Initialised: StepComplete (Co-Simulation) or EventMode (Model Exchange).
+    pub(crate) fn running(name: &str, kind: fmi2Type, logging: bool) -> Self {
+        let rig = Self::in_initialisation(name, kind, logging);
+        // SAFETY: our live instance.
+        assert_eq!(
+            unsafe { fmi2ExitInitializationMode::<S>(rig.c) },
+            fmi2Status_fmi2OK
+        );
+        rig
+    }
+
+    pub(crate) fn instance(&self) -> &Instance<S> {
+        // SAFETY: our live instance.
+        unsafe { Instance::<S>::from_ptr(self.c) }
+            .map(|i| &*i)
+            .expect("our instance")
+    }
+}
+
+impl<S: Slave> Drop for Rig<S> {
+    fn drop(&mut self) {
+        // SAFETY: our instance, freed once.
+        unsafe { fmi2FreeInstance::<S>(self.c) };
+    }
+}
+
+/// The last message logged for the instance `name`.
+pub(crate) fn last_log(name: &str) -> Option<(log::Level, String)> {
+    super::tests::logs_of(name).pop()
+}
