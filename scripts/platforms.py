@@ -32,7 +32,7 @@ CROSS = REPO / "target" / "cross"
 
 # platform: (runner command, binary inside the FMU)
 PLATFORMS = {
-    "linux64": ([str(REPO / "target" / "release" / "tld-scenes")], "binaries/linux64/{id}.so"),
+    "linux64": ([str(REPO / "target" / "x86_64-unknown-linux-gnu" / "release" / "tld-scenes")], "binaries/linux64/{id}.so"),
     "win64": (["/usr/lib/wine/wine64", str(CROSS / "x86_64-pc-windows-gnu" / "release" / "tld-scenes.exe")],
               "binaries/win64/{id}.dll"),
     "aarch64-linux": (["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu",
