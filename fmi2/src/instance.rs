@@ -382,6 +382,4 @@ fn finite_values<S: Slave>(context: &Context, slave: &S) -> Result<(), String> {
 }
 
 #[cfg(test)]
-mod probe;
-#[cfg(test)]
 mod tests;

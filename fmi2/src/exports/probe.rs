@@ -1,11 +1,16 @@
-//! Probe: a slave of the tests' own with a variable table of every kind the shared layer checks
-//! (a fixed and a tunable parameter with bounds, an Integer, an Enumeration, a calculated
+//! Probe: the slave of the shared layer's tests, with a variable table of every kind the layer
+//! checks (a fixed and a tunable parameter with bounds, an Integer, an Enumeration, a calculated
 //! parameter, a continuous and a discrete input, a Boolean, an output, a local), a quick path
-//! for some of them, first-order input and output derivatives, and two continuous states for
-//! Model Exchange. Its answers are simple enough to work out by hand:
+//! for some of them, first-order input and output derivatives, two continuous states for Model
+//! Exchange, and what the instance must handle: models that Model Exchange offers and one it
+//! does not, an initialisation warning, step notices, states whose outputs overflow. Its
+//! answers are simple enough to work out by hand:
 //!
 //! - y = k u, its derivative k du (du: u's input derivative), g = 2 k, l = c;
 //! - Model Exchange: x' = (x1, -k x0) (an oscillator), one event indicator x0;
+//! - n chooses the model: [`CS_ONLY`] runs in Co-Simulation only, [`WARNS`] initialises with a
+//!   warning; a Co-Simulation step of h counts itself and moves x0 by h, with a notice for a
+//!   step of [`NOTICE_STEP`];
 //! - it keeps the defaults of `Slave::flag` and of `Continuous`'s nominals, completed step,
 //!   event update and directional derivatives.
 //!
@@ -14,11 +19,10 @@
 
 use std::ffi::CString;
 use std::marker::PhantomData;
-use std::sync::Once;
 
 use fmi_sys::fmi2::*;
 
-use super::tests::Host;
+use super::tests::{instantiate, logs_of};
 use super::*;
 use crate::continuous::Continuous;
 use crate::description::{Causality, Table, VarType, Variability, Variable};
@@ -35,6 +39,14 @@ pub(crate) const JUMP: u32 = 21;
 pub(crate) const ON: u32 = 22;
 pub(crate) const Y: u32 = 30;
 pub(crate) const L: u32 = 31;
+
+/// Models, by n: Co-Simulation only; the start value; offered, with an initialisation warning.
+pub(crate) const CS_ONLY: i32 = 1;
+pub(crate) const ME: i32 = 3;
+pub(crate) const WARNS: i32 = 4;
+
+/// A Co-Simulation step of this size asks for its notice.
+pub(crate) const NOTICE_STEP: f64 = 0.25;
 
 #[allow(clippy::too_many_arguments)]
 const fn var(
@@ -145,7 +157,11 @@ pub(crate) struct Probe<const MARK: u64> {
     values: Vec<f64>,
     /// u's input derivative.
     du: f64,
-    x: [f64; 2],
+    pub(crate) x: [f64; 2],
+    /// Co-Simulation steps taken.
+    pub(crate) steps: u32,
+    /// How often initialisation was undone.
+    pub(crate) undone: u32,
     /// The flag `load` was given (None: not loaded).
     pub(crate) restored_flag: Option<bool>,
 }
@@ -160,6 +176,22 @@ impl<const MARK: u64> Probe<MARK> {
             _ => self.values[i],
         }
     }
+
+    /// The value of `vr`, as fmi2Get* hands it out.
+    pub(crate) fn value_of(&self, vr: u32) -> f64 {
+        self.value(at(vr))
+    }
+
+    /// With the stored value of `vr` changed (however out of bounds): for the states tests
+    /// make up.
+    pub(crate) fn with(mut self, vr: u32, value: f64) -> Self {
+        self.values[at(vr)] = value;
+        self
+    }
+
+    fn model(&self) -> i32 {
+        self.values[at(N)] as i32
+    }
 }
 
 impl<const MARK: u64> Continuous for Probe<MARK> {
@@ -167,7 +199,10 @@ impl<const MARK: u64> Continuous for Probe<MARK> {
     const EVENT_INDICATORS: usize = 1;
 
     fn offers_model_exchange(&self) -> Result<(), String> {
-        Ok(())
+        match self.model() {
+            CS_ONLY => Err(format!("n = {CS_ONLY} runs in Co-Simulation only")),
+            _ => Ok(()),
+        }
     }
     fn states(&self, x: &mut [f64]) -> Reply {
         x.copy_from_slice(&self.x);
@@ -198,15 +233,27 @@ impl<const MARK: u64> Slave for Probe<MARK> {
             values: VARIABLES.iter().map(|v| v.start.unwrap_or(0.0)).collect(),
             du: 0.0,
             x: [0.0; 2],
+            steps: 0,
+            undone: 0,
             restored_flag: None,
         }
     }
     fn initialise(&mut self, _: &Context) -> Result<Vec<String>, Refusal> {
-        Ok(Vec::new())
+        Ok(match self.model() {
+            WARNS => vec![format!("n = {WARNS} is approximate")],
+            _ => Vec::new(),
+        })
     }
-    fn uninitialise(&mut self) {}
-    fn step(&mut self, _: &Context, _: f64, _: f64) -> Result<bool, Refusal> {
-        Ok(false)
+    fn uninitialise(&mut self) {
+        self.undone += 1;
+    }
+    fn step(&mut self, _: &Context, _: f64, h: f64) -> Result<bool, Refusal> {
+        self.x[0] += h;
+        self.steps += 1;
+        Ok(h == NOTICE_STEP)
+    }
+    fn notice(&mut self, context: &Context) -> Option<String> {
+        Some(format!("a notice at t = {}", context.time))
     }
     fn get<T>(
         &self,
@@ -280,11 +327,13 @@ impl<const MARK: u64> Slave for Probe<MARK> {
         put_f64_list(out, &self.values);
         put_f64_list(out, &self.x);
         put_f64(out, self.du);
+        out.extend_from_slice(&self.steps.to_le_bytes());
     }
     fn load(_: &Context, flag: bool, part: &mut Reader) -> Result<Self, String> {
         let values = part.f64_list()?;
         let x = part.f64_list()?;
         let du = part.f64()?;
+        let steps = part.u32()?;
         let x: [f64; 2] = x.try_into().map_err(|_| "two states".to_string())?;
         if values.len() != VARIABLES.len() {
             return Err("one value per variable".into());
@@ -293,6 +342,8 @@ impl<const MARK: u64> Slave for Probe<MARK> {
             values,
             du,
             x,
+            steps,
+            undone: 0,
             restored_flag: Some(flag),
         })
     }
@@ -302,76 +353,45 @@ impl<const MARK: u64> Slave for Probe<MARK> {
 pub(crate) const MARK: u64 = 0x5052_4f42_4520_2020;
 pub(crate) type P = Probe<MARK>;
 
-/// The host's log goes to exports::tests' capture (one logger per process), which its
-/// hosts install: made once here for the tests that start with a Rig.
-fn capture_logs() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| drop(Host::new("capture-logs", None)));
-}
-
-/// An instance of `S` driven as a host drives it, logging through fmi-sys's C logger into
-/// exports::tests' capture under its `name` (each test its own).
+/// An instance of `S` made through fmi2Instantiate and driven as a host drives it, logging
+/// through fmi-sys's C logger into exports::tests' capture under its `name` (each test its
+/// own); freed on drop.
 pub(crate) struct Rig<S: Slave> {
     pub(crate) c: fmi2Component,
+    name: String,
     _callbacks: Box<fmi2CallbackFunctions>,
     _slave: PhantomData<S>,
 }
 
+const OK: fmi2Status = fmi2Status_fmi2OK;
+
 impl<S: Slave> Rig<S> {
-    /// Instantiated (`kind`: fmi2CoSimulation or fmi2ModelExchange), with logging on or off.
-    pub(crate) fn new(name: &str, kind: fmi2Type, logging: bool) -> Self {
-        capture_logs();
-        let callbacks = Box::new(fmi2CallbackFunctions {
-            logger: Some(fmi_sys::fmi2::logger::callback_logger_handler),
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: std::ptr::null_mut(),
-        });
-        let name = CString::new(name).expect("a test's name");
-        let guid = CString::new(S::TABLE.guid).expect("a GUID");
-        // SAFETY: valid strings and callbacks, which outlive the instance.
-        let c = unsafe {
-            fmi2Instantiate::<S>(
-                name.as_ptr(),
-                kind,
-                guid.as_ptr(),
-                std::ptr::null(),
-                &*callbacks,
-                0,
-                i32::from(logging),
-            )
-        };
-        assert!(!c.is_null());
+    /// Instantiated (`kind`: fmi2CoSimulation or fmi2ModelExchange), with fmi2Instantiate's
+    /// loggingOn.
+    pub(crate) fn new(name: &str, kind: fmi2Type, logging_on: bool) -> Self {
+        let (c, callbacks) = instantiate::<S>(name, kind, logging_on);
         Rig {
             c,
+            name: name.into(),
             _callbacks: callbacks,
             _slave: PhantomData,
         }
     }
 
     /// Instantiated, set up (no tolerance, start 0, no stop) and in initialisation mode.
-    pub(crate) fn in_initialisation(name: &str, kind: fmi2Type, logging: bool) -> Self {
-        let rig = Self::new(name, kind, logging);
+    pub(crate) fn in_initialisation(name: &str, kind: fmi2Type, logging_on: bool) -> Self {
+        let rig = Self::new(name, kind, logging_on);
+        assert_eq!(rig.setup(None, 0.0, None), OK);
         // SAFETY: our live instance.
-        unsafe {
-            assert_eq!(
-                fmi2SetupExperiment::<S>(rig.c, 0, 0.0, 0.0, 0, 0.0),
-                fmi2Status_fmi2OK
-            );
-            assert_eq!(fmi2EnterInitializationMode::<S>(rig.c), fmi2Status_fmi2OK);
-        }
+        assert_eq!(unsafe { fmi2EnterInitializationMode::<S>(rig.c) }, OK);
         rig
     }
 
     /// Initialised: StepComplete (Co-Simulation) or EventMode (Model Exchange).
-    pub(crate) fn running(name: &str, kind: fmi2Type, logging: bool) -> Self {
-        let rig = Self::in_initialisation(name, kind, logging);
+    pub(crate) fn running(name: &str, kind: fmi2Type, logging_on: bool) -> Self {
+        let rig = Self::in_initialisation(name, kind, logging_on);
         // SAFETY: our live instance.
-        assert_eq!(
-            unsafe { fmi2ExitInitializationMode::<S>(rig.c) },
-            fmi2Status_fmi2OK
-        );
+        assert_eq!(unsafe { fmi2ExitInitializationMode::<S>(rig.c) }, OK);
         rig
     }
 
@@ -380,6 +400,112 @@ impl<S: Slave> Rig<S> {
         unsafe { Instance::<S>::from_ptr(self.c) }
             .map(|i| &*i)
             .expect("our instance")
+    }
+
+    /// What the instance logged so far: (level, message).
+    pub(crate) fn logs(&self) -> Vec<(log::Level, String)> {
+        logs_of(&self.name)
+    }
+
+    pub(crate) fn setup(
+        &self,
+        tolerance: Option<f64>,
+        start: f64,
+        stop: Option<f64>,
+    ) -> fmi2Status {
+        let (tol_on, tol) = (i32::from(tolerance.is_some()), tolerance.unwrap_or(0.0));
+        let (stop_on, stop) = (i32::from(stop.is_some()), stop.unwrap_or(0.0));
+        // SAFETY: our live instance.
+        unsafe { fmi2SetupExperiment::<S>(self.c, tol_on, tol, start, stop_on, stop) }
+    }
+
+    /// fmi2EnterInitializationMode (which must pass), then fmi2ExitInitializationMode: the
+    /// second's status.
+    pub(crate) fn initialise(&self) -> fmi2Status {
+        // SAFETY: our live instance.
+        unsafe {
+            assert_eq!(fmi2EnterInitializationMode::<S>(self.c), OK);
+            fmi2ExitInitializationMode::<S>(self.c)
+        }
+    }
+
+    pub(crate) fn step(&self, t: f64, h: f64) -> fmi2Status {
+        // SAFETY: our live instance.
+        unsafe { fmi2DoStep::<S>(self.c, t, h, 0) }
+    }
+
+    pub(crate) fn set_real(&self, r: u32, v: f64) -> fmi2Status {
+        // SAFETY: our live instance; one value reference and one value.
+        unsafe { fmi2SetReal::<S>(self.c, &r, 1, &v) }
+    }
+
+    pub(crate) fn set_integer(&self, r: u32, v: i32) -> fmi2Status {
+        // SAFETY: as above.
+        unsafe { fmi2SetInteger::<S>(self.c, &r, 1, &v) }
+    }
+
+    pub(crate) fn get_real(&self, r: u32) -> (fmi2Status, f64) {
+        let mut v = f64::NAN;
+        // SAFETY: as above.
+        let status = unsafe { fmi2GetReal::<S>(self.c, &r, 1, &mut v) };
+        (status, v)
+    }
+
+    /// fmi2GetRealStatus(fmi2LastSuccessfulTime).
+    pub(crate) fn last_successful_time(&self) -> f64 {
+        let mut t = f64::NAN;
+        let kind = fmi2StatusKind_fmi2LastSuccessfulTime;
+        // SAFETY: our live instance, a valid out slot.
+        assert_eq!(unsafe { fmi2GetRealStatus::<S>(self.c, kind, &mut t) }, OK);
+        t
+    }
+
+    pub(crate) fn debug_logging(&self, on: bool, categories: &[&str]) -> fmi2Status {
+        let owned: Vec<CString> = categories
+            .iter()
+            .map(|c| CString::new(*c).expect("a category"))
+            .collect();
+        let pointers: Vec<fmi2String> = owned.iter().map(|c| c.as_ptr()).collect();
+        let (n, on) = (pointers.len(), i32::from(on));
+        // SAFETY: our live instance; the category strings outlive the call.
+        unsafe { fmi2SetDebugLogging::<S>(self.c, on, n, pointers.as_ptr()) }
+    }
+
+    /// The instance's state, serialised (fmi2GetFMUstate, fmi2SerializeFMUstate).
+    pub(crate) fn saved(&self) -> Vec<u8> {
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        let mut size = 0;
+        // SAFETY: our live instance and the state it makes, freed here.
+        unsafe {
+            assert_eq!(fmi2GetFMUstate::<S>(self.c, &mut state), OK);
+            assert_eq!(
+                fmi2SerializedFMUstateSize::<S>(self.c, state, &mut size),
+                OK
+            );
+            let mut bytes = vec![0u8; size];
+            let into = bytes.as_mut_ptr().cast();
+            assert_eq!(fmi2SerializeFMUstate::<S>(self.c, state, into, size), OK);
+            assert_eq!(fmi2FreeFMUstate::<S>(self.c, &mut state), OK);
+            bytes
+        }
+    }
+
+    /// Restore serialised `bytes`: fmi2DeSerializeFMUstate's status, and if it made a state,
+    /// fmi2SetFMUstate's.
+    pub(crate) fn restore(&self, bytes: &[u8]) -> (fmi2Status, Option<fmi2Status>) {
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        let (from, size) = (bytes.as_ptr().cast(), bytes.len());
+        // SAFETY: our live instance, the host's buffer, the state made here and freed.
+        unsafe {
+            let made = fmi2DeSerializeFMUstate::<S>(self.c, from, size, &mut state);
+            if made != OK {
+                assert!(state.is_null());
+                return (made, None);
+            }
+            let set = fmi2SetFMUstate::<S>(self.c, state);
+            fmi2FreeFMUstate::<S>(self.c, &mut state);
+            (made, Some(set))
+        }
     }
 }
 
@@ -392,5 +518,5 @@ impl<S: Slave> Drop for Rig<S> {
 
 /// The last message logged for the instance `name`.
 pub(crate) fn last_log(name: &str) -> Option<(log::Level, String)> {
-    super::tests::logs_of(name).pop()
+    logs_of(name).pop()
 }
