@@ -7,7 +7,7 @@ use super::{
     StepError, choice,
 };
 use crate::description::vr;
-use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
+use crate::physics::amplitude::{AmplitudeTracker, StagedTracker, TRACKER_STATE};
 use crate::solver::SolveStats;
 
 /// Numbers of a saved state after the model's own: amplitude, mean force (flag and value),
@@ -19,10 +19,11 @@ pub struct Damper {
     common: Common,
     derived: Derived,
     model: AnyModel,
-    tracker: Option<AmplitudeTracker>,
+    tracker: Option<StagedTracker>,
     /// Whether the damping law reads the amplitude: only then is a tracked amplitude estimated
-    /// before each step. Otherwise the tracker only takes in the step's input, and its estimate
-    /// is formed when something reads it (A_e.estimate, a saved state).
+    /// before each step. Otherwise the tracker takes in the step's input after the step, on the
+    /// step's own path ([`StagedTracker`]), and forms its estimate only when something reads it
+    /// (A_e.estimate, a saved state).
     damping_reads_amplitude: bool,
     /// Stored energy at the start [J]: counted as input.
     initial_energy: f64,
@@ -62,7 +63,7 @@ impl Damper {
                 // The velocity rebuild leaks at w_f/20: 0.5 % gain error at w_f/2, undone exactly.
                 (
                     prior,
-                    Some(AmplitudeTracker::new(tau, 0.05 * omega_f, prior, omega_f)),
+                    Some(AmplitudeTracker::new(tau, 0.05 * omega_f, prior, omega_f).into()),
                 )
             }
         };
@@ -103,38 +104,48 @@ impl Damper {
     /// this would add costs more than its body.
     #[inline(always)]
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
-        // Only a tracked amplitude that the damping law reads moves the damping; a fixed one
-        // was applied in configure.
-        match &self.tracker {
-            None => self.advance(self.zeta, t, h, inputs),
-            Some(_) if !self.damping_reads_amplitude => {
-                // The tracker takes in the input once the step has succeeded (all or nothing).
-                let report = self.advance(self.zeta, t, h, inputs)?;
-                if let Some(tracker) = self.tracker.as_mut() {
-                    tracker.update(h, inputs.a, inputs.v);
-                }
-                Ok(report)
-            }
-            Some(tracker) => {
-                let mut tracker = tracker.clone();
-                tracker.update(h, inputs.a, inputs.v);
-                self.step_tracked(tracker, t, h, inputs)
-            }
+        // A fixed amplitude was applied in configure. A tracked one that the damping law
+        // ignores writes the step's input down before the step and takes it in once the step
+        // has succeeded (all or nothing): the same code as a fixed one, nothing of the tracker
+        // live across the model's step. Anything else (the law reads the amplitude, or the tracker cannot
+        // write the input down) is out of line.
+        let inline = match self.tracker.as_mut() {
+            None => true,
+            Some(tracker) => !self.damping_reads_amplitude && tracker.stage(h, inputs.a, inputs.v),
+        };
+        if !inline {
+            return self.step_aside(t, h, inputs);
         }
+        self.advance(self.zeta, t, h, inputs, true)
     }
 
-    /// [`Damper::step`] with the amplitude tracker as it will be after the step, for a damping
-    /// law that reads the amplitude.
+    /// [`Damper::step`] with a tracked amplitude, when the step's input is taken in at once:
+    /// before the step for a damping law that reads the amplitude (the step uses the tracker
+    /// as it will be after it), after it for one that ignores the amplitude when the tracker
+    /// cannot write the input down (a new interval length, the host's base.v appearing).
     #[inline(never)]
-    fn step_tracked(
-        &mut self,
-        tracker: AmplitudeTracker,
-        t: f64,
-        h: f64,
-        inputs: &Inputs,
-    ) -> Result<Report, StepError> {
-        let report = self.advance(self.common.zeta(tracker.estimate()), t, h, inputs)?;
-        self.tracker = Some(tracker);
+    fn step_aside(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
+        let Some(staged) = self.tracker.as_mut() else {
+            return self.advance(self.zeta, t, h, inputs, false);
+        };
+        if !self.damping_reads_amplitude {
+            // Nothing written down (`staged` false): taken in here.
+            let report = self.advance(self.zeta, t, h, inputs, false)?;
+            if let Some(staged) = self.tracker.as_mut() {
+                staged.get_mut().update(h, inputs.a, inputs.v);
+            }
+            return Ok(report);
+        }
+        let mut tracker = staged.get().clone();
+        tracker.update(h, inputs.a, inputs.v);
+        let zeta = self.common.zeta(tracker.estimate());
+        let report = self.advance(zeta, t, h, inputs, false)?;
+        if let Some(kept) = self.tracker.as_mut() {
+            *kept.get_mut() = tracker;
+        }
+        // Only here does the damping ratio change (stored on the other paths, the same value
+        // stored on every step).
+        self.zeta = zeta;
         Ok(report)
     }
 
@@ -143,30 +154,40 @@ impl Damper {
     pub fn amplitude(&self) -> f64 {
         self.tracker
             .as_ref()
-            .map_or(self.amplitude, AmplitudeTracker::estimate)
+            .map_or(self.amplitude, |t| t.get().estimate())
     }
 
-    /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker. Small
-    /// (the models' steps are out of line), so inlined into both kinds of amplitude.
+    /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker, which
+    /// only takes in the input it wrote down (`staged`) once the step has succeeded. Small (the
+    /// models' steps are out of line), so inlined.
     #[inline(always)]
-    fn advance(&mut self, zeta: f64, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
+    fn advance(
+        &mut self,
+        zeta: f64,
+        t: f64,
+        h: f64,
+        inputs: &Inputs,
+        staged: bool,
+    ) -> Result<Report, StepError> {
         // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
         // input, and (t + h) - t is not h in floating point.
         let a = [inputs.a, inputs.a_derivatives[0], inputs.a_derivatives[1]];
         let limit = 100.0 * self.common.tank.length;
-        // 1/h is ready long before the step's impulse is.
-        let inv_h = 1.0 / h;
         let stepped = self.model.step(t, h, zeta, a, limit)?;
+        // The input a tracker wrote down for this step.
+        if staged && let Some(tracker) = self.tracker.as_mut() {
+            tracker.commit();
+        }
         self.per_step = [stepped.force, stepped.sloshing.0, stepped.sloshing.1];
         // 1/h overflows for a subnormal h (and 0 x inf is NaN): over so short a step the mean
-        // force is the force.
-        let mean_force = stepped.impulse * inv_h;
+        // force is the force. (Formed after the step: before it, 1/h would be kept in memory
+        // across the model's step.)
+        let mean_force = stepped.impulse * (1.0 / h);
         self.last_mean_force = Some(if mean_force.is_finite() {
             mean_force
         } else {
             stepped.force
         });
-        self.zeta = zeta;
         // Far beyond the walls (twice their distance): most likely a unit mistake, in the input
         // or the tank, which `notice` explains. An implausible input drives the sloshing there
         // within a step or two.
@@ -298,7 +319,7 @@ impl Damper {
             &self
                 .tracker
                 .as_ref()
-                .map_or([0.0; TRACKER_STATE], |t| t.state()),
+                .map_or([0.0; TRACKER_STATE], |t| t.get().state()),
         );
         out
     }
@@ -343,7 +364,7 @@ impl Damper {
         if let Some(tracker) = damper.tracker.as_mut() {
             let mut t = [0.0; TRACKER_STATE];
             t.copy_from_slice(&frame[3..]);
-            tracker.set_state(&t)?;
+            tracker.get_mut().set_state(&t)?;
         }
         // The damping the last step used, which the model keeps for the output rates.
         damper.zeta = damper.common.zeta(damper.amplitude());

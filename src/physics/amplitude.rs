@@ -172,6 +172,14 @@ impl AmplitudeTracker {
         if velocity != 0.0 && !self.measured_v_seen {
             self.restart_measured();
         }
+        self.apply(alpha, decay, decay_m1, accel, velocity);
+    }
+
+    /// The update proper, with the interval's coefficients and the velocity source settled:
+    /// the same operations whether a step is taken in at once ([`AmplitudeTracker::update`])
+    /// or after the model's step ([`StagedTracker`]), so the same bits.
+    #[inline(always)]
+    fn apply(&mut self, alpha: f64, decay: f64, decay_m1: f64, accel: f64, velocity: f64) {
         let v = if self.measured_v_seen {
             velocity
         } else {
@@ -419,6 +427,9 @@ impl AmplitudeTracker {
         (estimate, gradient)
     }
 }
+
+mod staged;
+pub use staged::StagedTracker;
 
 #[cfg(test)]
 mod tests;
