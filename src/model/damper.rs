@@ -7,7 +7,7 @@ use super::{
     StepError, choice,
 };
 use crate::description::vr;
-use crate::physics::amplitude::{AmplitudeTracker, StagedTracker, TRACKER_STATE};
+use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
 use crate::solver::SolveStats;
 
 /// Numbers of a saved state after the model's own: amplitude, mean force (flag and value),
@@ -19,11 +19,11 @@ pub struct Damper {
     common: Common,
     derived: Derived,
     model: AnyModel,
-    tracker: Option<StagedTracker>,
+    tracker: Option<AmplitudeTracker>,
     /// Whether the damping law reads the amplitude: only then is a tracked amplitude estimated
     /// before each step. Otherwise the tracker takes in the step's input after the step, on the
-    /// step's own path ([`StagedTracker`]), and forms its estimate only when something reads it
-    /// (A_e.estimate, a saved state).
+    /// fixed amplitude's path ([`Damper::step`]), and forms its estimate only when something
+    /// reads it (A_e.estimate, a saved state).
     damping_reads_amplitude: bool,
     /// Stored energy at the start [J]: counted as input.
     initial_energy: f64,
@@ -63,7 +63,7 @@ impl Damper {
                 // The velocity rebuild leaks at w_f/20: 0.5 % gain error at w_f/2, undone exactly.
                 (
                     prior,
-                    Some(AmplitudeTracker::new(tau, 0.05 * omega_f, prior, omega_f).into()),
+                    Some(AmplitudeTracker::new(tau, 0.05 * omega_f, prior, omega_f)),
                 )
             }
         };
@@ -105,13 +105,13 @@ impl Damper {
     #[inline(always)]
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
         // A fixed amplitude was applied in configure. A tracked one that the damping law
-        // ignores writes the step's input down before the step and takes it in once the step
-        // has succeeded (all or nothing): the same code as a fixed one, nothing of the tracker
-        // live across the model's step. Anything else (the law reads the amplitude, or the tracker cannot
-        // write the input down) is out of line.
-        let inline = match self.tracker.as_mut() {
+        // ignores takes in the step's input once the step has succeeded (all or nothing), on
+        // the same code as a fixed one: the input is read back from `inputs` after the model's
+        // step rather than kept (stored) across it. Anything else (the law reads the amplitude,
+        // a new interval length, the host's base.v appearing) is out of line.
+        let inline = match &self.tracker {
             None => true,
-            Some(tracker) => !self.damping_reads_amplitude && tracker.stage(h, inputs.a, inputs.v),
+            Some(tracker) => !self.damping_reads_amplitude && tracker.takes_in_as_is(h, inputs.v),
         };
         if !inline {
             return self.step_aside(t, h, inputs);
@@ -122,26 +122,26 @@ impl Damper {
     /// [`Damper::step`] with a tracked amplitude, when the step's input is taken in at once:
     /// before the step for a damping law that reads the amplitude (the step uses the tracker
     /// as it will be after it), after it for one that ignores the amplitude when the tracker
-    /// cannot write the input down (a new interval length, the host's base.v appearing).
+    /// cannot take it in as it is (a new interval length, the host's base.v appearing).
     #[inline(never)]
     fn step_aside(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
-        let Some(staged) = self.tracker.as_mut() else {
+        let Some(tracker) = &self.tracker else {
             return self.advance(self.zeta, t, h, inputs, false);
         };
         if !self.damping_reads_amplitude {
-            // Nothing written down (`staged` false): taken in here.
+            // (`advance` takes nothing in: `take_in` false.)
             let report = self.advance(self.zeta, t, h, inputs, false)?;
-            if let Some(staged) = self.tracker.as_mut() {
-                staged.get_mut().update(h, inputs.a, inputs.v);
+            if let Some(tracker) = self.tracker.as_mut() {
+                tracker.update(h, inputs.a, inputs.v);
             }
             return Ok(report);
         }
-        let mut tracker = staged.get().clone();
+        let mut tracker = tracker.clone();
         tracker.update(h, inputs.a, inputs.v);
         let zeta = self.common.zeta(tracker.estimate());
         let report = self.advance(zeta, t, h, inputs, false)?;
         if let Some(kept) = self.tracker.as_mut() {
-            *kept.get_mut() = tracker;
+            *kept = tracker;
         }
         // Only here does the damping ratio change (stored on the other paths, the same value
         // stored on every step).
@@ -154,11 +154,11 @@ impl Damper {
     pub fn amplitude(&self) -> f64 {
         self.tracker
             .as_ref()
-            .map_or(self.amplitude, |t| t.get().estimate())
+            .map_or(self.amplitude, AmplitudeTracker::estimate)
     }
 
     /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker, which
-    /// only takes in the input it wrote down (`staged`) once the step has succeeded. Small (the
+    /// only takes in the step's input (`take_in`) once the step has succeeded. Small (the
     /// models' steps are out of line), so inlined.
     #[inline(always)]
     fn advance(
@@ -167,16 +167,19 @@ impl Damper {
         t: f64,
         h: f64,
         inputs: &Inputs,
-        staged: bool,
+        take_in: bool,
     ) -> Result<Report, StepError> {
         // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
         // input, and (t + h) - t is not h in floating point.
         let a = [inputs.a, inputs.a_derivatives[0], inputs.a_derivatives[1]];
         let limit = 100.0 * self.common.tank.length;
         let stepped = self.model.step(t, h, zeta, a, limit)?;
-        // The input a tracker wrote down for this step.
-        if staged && let Some(tracker) = self.tracker.as_mut() {
-            tracker.commit();
+        // The tracker's part, the input read back through an opaque reference: kept in
+        // registers across the model's step it would be stored on the fixed amplitude's path
+        // too, and a store before the step costs that path time (docs/ARCHITECTURE.md).
+        if take_in && let Some(tracker) = self.tracker.as_mut() {
+            let inputs = std::hint::black_box(inputs);
+            tracker.take_in(inputs.a, inputs.v);
         }
         self.per_step = [stepped.force, stepped.sloshing.0, stepped.sloshing.1];
         // 1/h overflows for a subnormal h (and 0 x inf is NaN): over so short a step the mean
@@ -319,7 +322,7 @@ impl Damper {
             &self
                 .tracker
                 .as_ref()
-                .map_or([0.0; TRACKER_STATE], |t| t.get().state()),
+                .map_or([0.0; TRACKER_STATE], |t| t.state()),
         );
         out
     }
@@ -364,7 +367,7 @@ impl Damper {
         if let Some(tracker) = damper.tracker.as_mut() {
             let mut t = [0.0; TRACKER_STATE];
             t.copy_from_slice(&frame[3..]);
-            tracker.get_mut().set_state(&t)?;
+            tracker.set_state(&t)?;
         }
         // The damping the last step used, which the model keeps for the output rates.
         damper.zeta = damper.common.zeta(damper.amplitude());

@@ -38,8 +38,7 @@ impl Damper {
             Some(t) => {
                 let mut t = t.clone();
                 // Any finite trial state is taken (a mean square slightly below 0 included).
-                t.get_mut()
-                    .set_continuous_state(tracker)
+                t.set_continuous_state(tracker)
                     .map_err(StatesRefused::Invalid)?;
                 Some(t)
             }

@@ -26,7 +26,7 @@ impl Damper {
         *out = self
             .tracker
             .as_ref()
-            .map_or([0.0; TRACKER_CONTINUOUS], |t| t.get().continuous_state());
+            .map_or([0.0; TRACKER_CONTINUOUS], |t| t.continuous_state());
     }
 
     /// Their derivatives under the inputs now (0 with a fixed amplitude).
@@ -35,7 +35,7 @@ impl Damper {
             .tracker
             .as_ref()
             .map_or([0.0; TRACKER_CONTINUOUS], |t| {
-                t.get().continuous_rates(inputs.a, inputs.v)
+                t.continuous_rates(inputs.a, inputs.v)
             });
     }
 
@@ -61,7 +61,6 @@ impl Damper {
         let Some(t) = &self.tracker else {
             return TrackerTangent::default();
         };
-        let t = t.get();
         let (estimate, gradient) = t.continuous_estimate();
         let d_estimate: f64 = gradient.iter().zip(&d.tracker).map(|(g, s)| g * s).sum();
         TrackerTangent {
@@ -75,7 +74,7 @@ impl Damper {
     pub fn tracker_event_pending(&self, inputs: &Inputs) -> bool {
         self.tracker
             .as_ref()
-            .is_some_and(|t| t.get().would_see_velocity(inputs.v))
+            .is_some_and(|t| t.would_see_velocity(inputs.v))
     }
 
     /// Make that switch (the statistics restart): true if the states changed.
@@ -83,7 +82,7 @@ impl Damper {
         let changed = self
             .tracker
             .as_mut()
-            .is_some_and(|t| t.get_mut().sees_velocity(inputs.v));
+            .is_some_and(|t| t.sees_velocity(inputs.v));
         if changed {
             self.apply_tracked_damping();
         }
@@ -93,7 +92,7 @@ impl Damper {
     /// The damping ratio of the tracked estimate now, into the model.
     pub(super) fn apply_tracked_damping(&mut self) {
         if let Some(t) = &self.tracker {
-            self.zeta = self.common.zeta(t.get().estimate());
+            self.zeta = self.common.zeta(t.estimate());
             self.model.set_damping(self.zeta);
         }
     }
