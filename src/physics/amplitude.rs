@@ -197,7 +197,7 @@ impl AmplitudeTracker {
     /// taken in after the step, on the step's own path, without either.
     #[inline(always)]
     pub fn takes_in_as_is(&self, h: f64, velocity: f64) -> bool {
-        self.coefficients.h == h && !(velocity != 0.0 && !self.measured_v_seen)
+        self.coefficients.h == h && (velocity == 0.0 || self.measured_v_seen)
     }
 
     /// [`AmplitudeTracker::update`] where [`AmplitudeTracker::takes_in_as_is`] holds (for the
