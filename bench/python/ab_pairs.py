@@ -16,15 +16,14 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
-import subprocess
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ab import run
 from ab_settings import Description, c_cases, cases
 from tld_fmu.paths import REPO
-from tld_fmu.scenes import NATIVE_BIN
 
 
 def main(argv=None):
@@ -54,12 +53,7 @@ def main(argv=None):
             lines += [f"run {i}_{n}_{r} fmu {' '.join(tokens[n])}" for n in names]
     job = tmp / "pairs.job"
     job.write_text("\n".join(lines) + "\n")
-    out = subprocess.run([str(NATIVE_BIN), str(job)], capture_output=True, text=True, check=True)
-    t = {}
-    for line in out.stdout.splitlines():
-        tok = line.split()
-        if tok and tok[0] == "result" and tok[2] == "ok":
-            t[tok[1]] = int(tok[4]) / int(tok[3])
+    t = run(job)
     rounds = range(args.rounds)
     for i, lib in enumerate(libs):
         med = " ".join(f"{n}={statistics.median(t[f'{i}_{n}_{r}'] for r in rounds):.1f}"
