@@ -359,21 +359,6 @@ impl<S: Slave> Instance<S> {
     }
 }
 
-/// Every Real variable of a slave just loaded from a state that the slave can read is finite.
-/// A state is bytes from a host: one that passes the frame's checks (its checksum recomputed)
-/// and the slave's own can still hold finite numbers from which outputs and derivatives come
-/// out infinite or NaN (coverage-guided fuzzing found such a TLD state: fuzz/, docs/FUZZING.md).
-fn finite_values<S: Slave>(context: &Context, slave: &S) -> Result<(), String> {
-    for v in S::TABLE.variables.iter().filter(|v| v.ty == VarType::Real) {
-        let mut x = [0.0];
-        let read = slave.get(context, &[v.vr], &mut x, VarType::Real, "", |x| x);
-        if read.is_ok() && !x[0].is_finite() {
-            return Err(format!("its values give {} = {}", v.name, x[0]));
-        }
-    }
-    Ok(())
-}
-
 /// fmi2DoStep's refusals of its arguments, out of line (see [`super::Instance::do_step`]).
 mod step_refusal {
     use crate::status::{Refusal, refuse};
@@ -409,4 +394,19 @@ mod step_refusal {
             "fmi2DoStep: the step to {end} would pass the stop time {stop}"
         ))
     }
+}
+
+/// Every Real variable of a slave just loaded from a state that the slave can read is finite.
+/// A state is bytes from a host: one that passes the frame's checks (its checksum recomputed)
+/// and the slave's own can still hold finite numbers from which outputs and derivatives come
+/// out infinite or NaN (coverage-guided fuzzing found such a TLD state: fuzz/, docs/FUZZING.md).
+fn finite_values<S: Slave>(context: &Context, slave: &S) -> Result<(), String> {
+    for v in S::TABLE.variables.iter().filter(|v| v.ty == VarType::Real) {
+        let mut x = [0.0];
+        let read = slave.get(context, &[v.vr], &mut x, VarType::Real, "", |x| x);
+        if read.is_ok() && !x[0].is_finite() {
+            return Err(format!("its values give {} = {}", v.name, x[0]));
+        }
+    }
+    Ok(())
 }
