@@ -235,31 +235,24 @@ impl<S: Slave> Instance<S> {
 
     #[inline]
     pub fn do_step(&mut self, t: f64, h: f64) -> Reply {
+        // The refusals are made out of line from the values: a message formed here would keep
+        // t, h and the times in memory for its arguments on every step.
         if !(crate::description::finite(h) && h > 0.0) {
-            return Err(refuse(format!(
-                "fmi2DoStep: communicationStepSize {h} must be positive and finite"
-            )));
+            return Err(step_refusal::size(h));
         }
         if !crate::description::finite(t) {
-            return Err(refuse(format!(
-                "fmi2DoStep: currentCommunicationPoint {t} is not finite"
-            )));
+            return Err(step_refusal::point(t));
         }
         let now = self.context.time;
         // Hosts accumulate time with rounding: accept a small mismatch, refuse a real one.
         let slack = 1e-9 * now.abs().max(1.0) + 1e-6 * h;
         if (t - now).abs() > slack {
-            return Err(refuse(format!(
-                "fmi2DoStep: currentCommunicationPoint {t} does not match the FMU's time {now} (the FMU cannot jump in time)"
-            )));
+            return Err(step_refusal::jump(t, now));
         }
         if let Some(stop) = self.context.experiment.stop
             && t + h > stop + 1e-9 * stop.abs().max(1.0) + 1e-6 * h
         {
-            return Err(refuse(format!(
-                "fmi2DoStep: the step to {} would pass the stop time {stop}",
-                t + h
-            )));
+            return Err(step_refusal::past_stop(t + h, stop));
         }
         let noticed = self.slave.step(&self.context, t, h)?;
         self.context.time = t + h;
@@ -363,6 +356,43 @@ impl<S: Slave> Instance<S> {
         self.context = context;
         self.slave = slave;
         Ok(Status::Ok)
+    }
+}
+
+/// fmi2DoStep's refusals of its arguments, out of line (see [`super::Instance::do_step`]).
+mod step_refusal {
+    use crate::status::{Refusal, refuse};
+
+    #[cold]
+    #[inline(never)]
+    pub fn size(h: f64) -> Refusal {
+        refuse(format!(
+            "fmi2DoStep: communicationStepSize {h} must be positive and finite"
+        ))
+    }
+
+    #[cold]
+    #[inline(never)]
+    pub fn point(t: f64) -> Refusal {
+        refuse(format!(
+            "fmi2DoStep: currentCommunicationPoint {t} is not finite"
+        ))
+    }
+
+    #[cold]
+    #[inline(never)]
+    pub fn jump(t: f64, now: f64) -> Refusal {
+        refuse(format!(
+            "fmi2DoStep: currentCommunicationPoint {t} does not match the FMU's time {now} (the FMU cannot jump in time)"
+        ))
+    }
+
+    #[cold]
+    #[inline(never)]
+    pub fn past_stop(end: f64, stop: f64) -> Refusal {
+        refuse(format!(
+            "fmi2DoStep: the step to {end} would pass the stop time {stop}"
+        ))
     }
 }
 

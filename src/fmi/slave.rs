@@ -114,8 +114,11 @@ impl Slave for Tld {
             .ok_or_else(|| refuse("fmi2DoStep: no simulation (not initialised)"))?;
         match sim.step(t, h, &inputs) {
             Ok(report) => {
-                // Input derivatives describe one communication step.
-                self.a_derivatives = [0.0; 2];
+                // Input derivatives describe one communication step. Reset only when set (any
+                // bit, -0 included): a store on every step otherwise.
+                if self.a_derivatives.iter().any(|d| d.to_bits() != 0) {
+                    self.a_derivatives = [0.0; 2];
+                }
                 Ok(report.implausible)
             }
             Err(e) => Err(step_failed(t, h, e)),

@@ -21,8 +21,9 @@ pub struct Damper {
     model: AnyModel,
     tracker: Option<AmplitudeTracker>,
     /// Whether the damping law reads the amplitude: only then is a tracked amplitude estimated
-    /// before each step. Otherwise the tracker only takes in the step's input, and its estimate
-    /// is formed when something reads it (A_e.estimate, a saved state).
+    /// before each step. Otherwise the tracker takes in the step's input after the step, on the
+    /// fixed amplitude's path ([`Damper::step`]), and forms its estimate only when something
+    /// reads it (A_e.estimate, a saved state).
     damping_reads_amplitude: bool,
     /// Stored energy at the start [J]: counted as input.
     initial_energy: f64,
@@ -103,38 +104,48 @@ impl Damper {
     /// this would add costs more than its body.
     #[inline(always)]
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
-        // Only a tracked amplitude that the damping law reads moves the damping; a fixed one
-        // was applied in configure.
-        match &self.tracker {
-            None => self.advance(self.zeta, t, h, inputs),
-            Some(_) if !self.damping_reads_amplitude => {
-                // The tracker takes in the input once the step has succeeded (all or nothing).
-                let report = self.advance(self.zeta, t, h, inputs)?;
-                if let Some(tracker) = self.tracker.as_mut() {
-                    tracker.update(h, inputs.a, inputs.v);
-                }
-                Ok(report)
-            }
-            Some(tracker) => {
-                let mut tracker = tracker.clone();
-                tracker.update(h, inputs.a, inputs.v);
-                self.step_tracked(tracker, t, h, inputs)
-            }
+        // A fixed amplitude was applied in configure. A tracked one that the damping law
+        // ignores takes in the step's input once the step has succeeded (all or nothing), on
+        // the same code as a fixed one: the input is read back from `inputs` after the model's
+        // step rather than kept (stored) across it. Anything else (the law reads the amplitude,
+        // a new interval length, the host's base.v appearing) is out of line.
+        let inline = match &self.tracker {
+            None => true,
+            Some(tracker) => !self.damping_reads_amplitude && tracker.takes_in_as_is(h, inputs.v),
+        };
+        if !inline {
+            return self.step_aside(t, h, inputs);
         }
+        self.advance(self.zeta, t, h, inputs, true)
     }
 
-    /// [`Damper::step`] with the amplitude tracker as it will be after the step, for a damping
-    /// law that reads the amplitude.
+    /// [`Damper::step`] with a tracked amplitude, when the step's input is taken in at once:
+    /// before the step for a damping law that reads the amplitude (the step uses the tracker
+    /// as it will be after it), after it for one that ignores the amplitude when the tracker
+    /// cannot take it in as it is (a new interval length, the host's base.v appearing).
     #[inline(never)]
-    fn step_tracked(
-        &mut self,
-        tracker: AmplitudeTracker,
-        t: f64,
-        h: f64,
-        inputs: &Inputs,
-    ) -> Result<Report, StepError> {
-        let report = self.advance(self.common.zeta(tracker.estimate()), t, h, inputs)?;
-        self.tracker = Some(tracker);
+    fn step_aside(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
+        let Some(tracker) = &self.tracker else {
+            return self.advance(self.zeta, t, h, inputs, false);
+        };
+        if !self.damping_reads_amplitude {
+            // (`advance` takes nothing in: `take_in` false.)
+            let report = self.advance(self.zeta, t, h, inputs, false)?;
+            if let Some(tracker) = self.tracker.as_mut() {
+                tracker.update(h, inputs.a, inputs.v);
+            }
+            return Ok(report);
+        }
+        let mut tracker = tracker.clone();
+        tracker.update(h, inputs.a, inputs.v);
+        let zeta = self.common.zeta(tracker.estimate());
+        let report = self.advance(zeta, t, h, inputs, false)?;
+        if let Some(kept) = self.tracker.as_mut() {
+            *kept = tracker;
+        }
+        // Only here does the damping ratio change (stored on the other paths, the same value
+        // stored on every step).
+        self.zeta = zeta;
         Ok(report)
     }
 
@@ -146,27 +157,40 @@ impl Damper {
             .map_or(self.amplitude, AmplitudeTracker::estimate)
     }
 
-    /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker. Small
-    /// (the models' steps are out of line), so inlined into both kinds of amplitude.
+    /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker, which
+    /// only takes in the step's input (`take_in`) once the step has succeeded. Small (the
+    /// models' steps are out of line), so inlined.
     #[inline(always)]
-    fn advance(&mut self, zeta: f64, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
+    fn advance(
+        &mut self,
+        zeta: f64,
+        t: f64,
+        h: f64,
+        inputs: &Inputs,
+        take_in: bool,
+    ) -> Result<Report, StepError> {
         // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
         // input, and (t + h) - t is not h in floating point.
         let a = [inputs.a, inputs.a_derivatives[0], inputs.a_derivatives[1]];
         let limit = 100.0 * self.common.tank.length;
-        // 1/h is ready long before the step's impulse is.
-        let inv_h = 1.0 / h;
         let stepped = self.model.step(t, h, zeta, a, limit)?;
+        // The tracker's part, the input read back through an opaque reference: kept in
+        // registers across the model's step it would be stored on the fixed amplitude's path
+        // too, and a store before the step costs that path time (docs/ARCHITECTURE.md).
+        if take_in && let Some(tracker) = self.tracker.as_mut() {
+            let inputs = std::hint::black_box(inputs);
+            tracker.take_in(inputs.a, inputs.v);
+        }
         self.per_step = [stepped.force, stepped.sloshing.0, stepped.sloshing.1];
         // 1/h overflows for a subnormal h (and 0 x inf is NaN): over so short a step the mean
-        // force is the force.
-        let mean_force = stepped.impulse * inv_h;
+        // force is the force. (Formed after the step: before it, 1/h would be kept in memory
+        // across the model's step.)
+        let mean_force = stepped.impulse * (1.0 / h);
         self.last_mean_force = Some(if mean_force.is_finite() {
             mean_force
         } else {
             stepped.force
         });
-        self.zeta = zeta;
         // Far beyond the walls (twice their distance): most likely a unit mistake, in the input
         // or the tank, which `notice` explains. An implausible input drives the sloshing there
         // within a step or two.

@@ -337,31 +337,38 @@ impl Nonlinear {
         };
         // The model takes this step's damping and input in place (field by field: a whole-struct
         // copy here stalls on store forwarding) and gets its previous ones back if the step fails.
+        // Only what changed is stored: a held input under a constant damping ratio changes
+        // base.a alone, and a store costs more on this path than a compare.
         let previous = (self.tld.c, self.tld.base);
-        self.tld.c = 2.0 * zeta * self.omega_f;
-        self.tld.base.t0 = 0.0;
-        self.tld.base.a = base.a;
+        keep(&mut self.tld.c, 2.0 * zeta * self.omega_f);
+        keep(&mut self.tld.base.t0, 0.0);
+        self.tld.base.a[0] = a0;
+        keep(&mut self.tld.base.a[1], a1);
+        keep(&mut self.tld.base.a[2], a2);
+        // The input's part of the impulse, formed before the step: one value kept across it
+        // instead of the input and h.
+        let input_impulse = base.integral(h);
         let v0 = self.y[state::V];
-        let taken = match shortcut {
-            Some(s) => take_shortcut(s, &self.tld, &self.y, t, h, zeta, a0, a1, a2, limit),
-            None => None,
-        };
-        let outcome = match taken {
-            Some(next) => next.map(|next| {
+        // (No shortcut: straight to the integration, no answer of the shortcut's kept in memory.)
+        let outcome = if let Some(s) = shortcut
+            && let Some(next) = take_shortcut(s, &self.tld, &self.y, t, h, zeta, a0, a1, a2, limit)
+        {
+            next.map(|next| {
                 self.y = next;
                 let stats = SolveStats {
                     accepted: 1,
                     ..SolveStats::default()
                 };
                 (stats, self.tld.tank_force(next[state::X], next[state::V]))
-            }),
-            None => self.tld.with_exponent(Integration {
+            })
+        } else {
+            self.tld.with_exponent(Integration {
                 integrator: &mut self.integrator,
                 t,
                 h,
                 y: &mut self.y,
                 limit,
-            }),
+            })
         };
         let (stats, force) = match outcome {
             Ok(done) => done,
@@ -373,13 +380,21 @@ impl Nonlinear {
         // The impulse on the tank follows from the velocity change, v' = -a_b - f:
         // integral f = -dv - integral a_b (for a Runge-Kutta step too, the input's quadrature
         // being exact).
-        let impulse = self.mass * (-(self.y[state::V] - v0) - base.integral(h));
+        let impulse = self.mass * (-(self.y[state::V] - v0) - input_impulse);
         Ok(Stepped {
             stats,
             impulse,
             force: self.mass * force,
             sloshing: (self.y[state::X], self.y[state::V]),
         })
+    }
+}
+
+/// `*slot = value`, storing only if the bits differ (the same bits in memory either way).
+#[inline(always)]
+fn keep(slot: &mut f64, value: f64) {
+    if slot.to_bits() != value.to_bits() {
+        *slot = value;
     }
 }
 

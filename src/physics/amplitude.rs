@@ -172,6 +172,14 @@ impl AmplitudeTracker {
         if velocity != 0.0 && !self.measured_v_seen {
             self.restart_measured();
         }
+        self.apply(alpha, decay, decay_m1, accel, velocity);
+    }
+
+    /// The update proper, with the interval's coefficients and the velocity source settled:
+    /// the same operations whether a step is taken in at once ([`AmplitudeTracker::update`])
+    /// or after the model's step ([`AmplitudeTracker::take_in`]), so the same bits.
+    #[inline(always)]
+    fn apply(&mut self, alpha: f64, decay: f64, decay_m1: f64, accel: f64, velocity: f64) {
         let v = if self.measured_v_seen {
             velocity
         } else {
@@ -181,6 +189,28 @@ impl AmplitudeTracker {
         self.weight.update(alpha, [1.0]);
         // Exact advance of v' = a - w_c v with a held.
         self.rebuilt_v = self.rebuilt_v * decay - accel * decay_m1 / self.leak;
+    }
+
+    /// Whether [`AmplitudeTracker::update`] over an interval of length `h` with the base
+    /// velocity `velocity` would be [`AmplitudeTracker::take_in`] alone: the coefficients are
+    /// for `h` and `velocity` does not switch the velocity source. Then a step's input can be
+    /// taken in after the step, on the step's own path, without either.
+    #[inline(always)]
+    pub fn takes_in_as_is(&self, h: f64, velocity: f64) -> bool {
+        self.coefficients.h == h && (velocity == 0.0 || self.measured_v_seen)
+    }
+
+    /// [`AmplitudeTracker::update`] where [`AmplitudeTracker::takes_in_as_is`] holds (for the
+    /// interval length and base velocity it was asked with), the same operations.
+    #[inline(always)]
+    pub fn take_in(&mut self, accel: f64, velocity: f64) {
+        let Coefficients {
+            alpha,
+            decay,
+            decay_m1,
+            ..
+        } = self.coefficients;
+        self.apply(alpha, decay, decay_m1, accel, velocity);
     }
 
     /// The coefficients for intervals of length `h`.

@@ -222,3 +222,38 @@ fn the_continuous_estimates_gradient_is_its_change() {
         }
     }
 }
+
+/// Taken in after a check, as the damper does on the fixed amplitude's path (a new interval
+/// length and the host's base.v appearing halfway taken in by `update` instead), the tracker
+/// is the one `update` makes, bit for bit, and nearly every step went the checked way.
+#[test]
+fn taken_in_as_is_is_the_update() {
+    let (tau, leak, prior, w) = (2.2, 0.28, 0.005, 5.9);
+    let mut eager = AmplitudeTracker::new(tau, leak, prior, w);
+    let mut checked = eager.clone();
+    let (mut t, mut as_is) = (0.0, 0);
+    for k in 0..2000 {
+        let h = [1e-3, 4e-3, 1e-3, 2.5e-3][(k / 300) % 4];
+        let accel = -w * w * 0.003 * (w * t).sin();
+        let velocity = if k >= 1000 {
+            w * 0.003 * (w * t).cos()
+        } else {
+            0.0
+        };
+        if checked.takes_in_as_is(h, velocity) {
+            checked.take_in(accel, velocity);
+            as_is += 1;
+        } else {
+            checked.update(h, accel, velocity);
+        }
+        eager.update(h, accel, velocity);
+        assert_eq!(
+            checked.state().map(f64::to_bits),
+            eager.state().map(f64::to_bits),
+            "step {k}"
+        );
+        t += h;
+    }
+    assert_eq!(checked.estimate().to_bits(), eager.estimate().to_bits());
+    assert!(as_is > 1990, "{as_is}");
+}
