@@ -123,6 +123,47 @@ fn a_step_is_the_free_decay_and_every_output_reads_by_its_name() {
     }
 }
 
+/// fmi2GetRealOutputDerivatives (order 1, exact) of every output: Eq 2.1's oscillator's
+/// rates for Linear (slosh.x' = v, slosh.v' = -a - 2 zeta w v - w^2 x, the base's power
+/// energy.input' = -m a v, the damping's energy.dissipated' = 2 zeta w m v^2, force' =
+/// m (2 zeta w v' + w^2 v), impact.z' = 0: no impact mass), the others the simulation's own
+/// rates; none before initialisation, and order 2 refused.
+#[test]
+fn output_derivatives_are_the_oscillators_rates() {
+    let p = Phase::StepComplete;
+    let (m, w) = mode_one();
+    let fresh = instance(LINEAR, FIXED, 0.005, &[]);
+    let c = context(p);
+    let none = fresh.output_derivatives(&c, &[vr::FORCE], &[1], |_, _| {});
+    refused(none, &["not initialised"]);
+    let mut tld = initialised(fresh);
+    let a = 0.7;
+    set_real(&mut tld, p, vr::BASE_A, a);
+    assert!(step(&mut tld, 0.0, 0.3).is_ok());
+    let vrs: Vec<u32> = OUTPUTS.iter().map(|(name, _)| named(name)).collect();
+    let mut got = vec![f64::NAN; vrs.len()];
+    let reply = tld.output_derivatives(&c, &vrs, &vec![1; vrs.len()], |k, v| got[k] = v);
+    assert_eq!(reply.map_err(|e| e.message), Ok(Status::Ok));
+    let (x, v) = (real(&tld, p, vr::SLOSH_X), real(&tld, p, vr::SLOSH_V));
+    let dv = -a - 2.0 * ZETA * w * v - w * w * x;
+    let sim = tld.sim.as_ref().expect("initialised");
+    let inputs = tld.values.inputs([0.0; 2]);
+    for (k, (name, which)) in OUTPUTS.into_iter().enumerate() {
+        let want = match name {
+            "slosh.x" => v,
+            "slosh.v" => dv,
+            "energy.input" => -m * a * v,
+            "energy.dissipated" => 2.0 * ZETA * w * m * v * v,
+            "force" => m * (2.0 * ZETA * w * dv + w * w * v),
+            "impact.z" => 0.0,
+            _ => sim.output_derivative(which, &inputs),
+        };
+        close(got[k], want, 1e-12, name);
+    }
+    let order_2 = tld.output_derivatives(&c, &[vr::SLOSH_X], &[2], |_, _| {});
+    refused(order_2, &["order 2 of 'slosh.x'"]);
+}
+
 /// The calculated parameters, and the outputs before initialisation (from the simulation the
 /// parameters set so far would start), read by name: Eq 2.1's and Eq 2.2's numbers.
 #[test]
