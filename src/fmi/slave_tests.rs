@@ -6,8 +6,10 @@
 //! ranges the model description declares, and the FMI 2.0 rules (a refused call changes
 //! nothing; input derivatives hold for one step; a saved state restores the same instance).
 
+// The test's tank (me_tests.rs): 0.6 x 0.25 x 0.07 m, two tanks, zeta 0.04, x0 = 0.015 m.
 use super::super::me_tests::{
-    FIXED, LINEAR, close, context, initialised, instance, mode_one, named, real, set_real,
+    A, B, FIXED, H, LINEAR, SLAMMING, TANKS, X0, ZETA, close, context, initialised, instance,
+    mode_one, named, real, set_real,
 };
 use super::*;
 use crate::model::Output;
@@ -16,15 +18,6 @@ use fmi2_slave::calls::Phase;
 use fmi2_slave::frame::{Common, Experiment, decode, encode};
 use fmi2_slave::{Continuous, Status};
 use vars::VarType;
-
-/// The test's tank (me_tests.rs): 0.6 x 0.25 x 0.07 m, two tanks, zeta 0.04, x0 = 0.015 m.
-const A: f64 = 0.6;
-const B: f64 = 0.25;
-const H: f64 = 0.07;
-const TANKS: f64 = 2.0;
-const ZETA: f64 = 0.04;
-const X0: f64 = 0.015;
-const SLAMMING: i32 = 3;
 
 /// Free decay of a damped oscillator from (x0, 0): (x, v) at t, in closed form.
 fn free_decay(t: f64) -> (f64, f64) {
