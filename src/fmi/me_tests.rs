@@ -18,18 +18,18 @@ use fmi2_slave::{Context, Continuous, Refusal, Slave, Status};
 
 /// Enumeration items (modelDescription.xml).
 pub(super) const LINEAR: i32 = 1;
-const SLAMMING: i32 = 3;
+pub(super) const SLAMMING: i32 = 3;
 const SHALLOW_WATER: i32 = 5;
 const CONSTANT: i32 = 1;
 pub(super) const FIXED: i32 = 1;
 pub(super) const TRACKED: i32 = 2;
 /// A tank that is not the defaults' (no product of its numbers 1), two of them.
-const A: f64 = 0.6;
-const B: f64 = 0.25;
-const H: f64 = 0.07;
-const TANKS: f64 = 2.0;
-const ZETA: f64 = 0.04;
-const X0: f64 = 0.015;
+pub(super) const A: f64 = 0.6;
+pub(super) const B: f64 = 0.25;
+pub(super) const H: f64 = 0.07;
+pub(super) const TANKS: f64 = 2.0;
+pub(super) const ZETA: f64 = 0.04;
+pub(super) const X0: f64 = 0.015;
 /// The tracker's position among all states.
 pub(super) const T0: usize = STATES;
 

@@ -269,6 +269,10 @@ pub const fn output_of(vr: u32) -> Option<Output> {
 }
 
 #[cfg(test)]
+#[path = "params_tests.rs"]
+mod saved_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 

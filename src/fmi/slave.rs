@@ -241,6 +241,10 @@ impl Slave for Tld {
     }
 }
 
+#[cfg(test)]
+#[path = "slave_tests.rs"]
+mod tests;
+
 /// Why a step failed, as the host is told: fmi2Discard when a smaller step may succeed.
 #[cold]
 #[inline(never)]

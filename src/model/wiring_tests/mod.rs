@@ -6,6 +6,7 @@
 //! ones. Each run also saves and restores its state half way. Seconds in all: a wrong wiring
 //! fails `cargo test` at once (issue 30, and scripts/mutants over src/model).
 
+mod bounds;
 mod nonlinear;
 mod shallow_water;
 mod slamming;
