@@ -39,16 +39,23 @@ pub enum Cell {
 
 /// The bank position `r` names, if it names one.
 pub fn cell_of(r: u32) -> Option<Cell> {
+    cell_in(r, ME_CELLS)
+}
+
+/// The position `r` names in a bank of `cells` cells (a parameter, so that the tests check the
+/// numbering with a bank of their own while the declared one is empty).
+#[inline]
+fn cell_in(r: u32, cells: usize) -> Option<Cell> {
     let at = |base: u32, offset: usize| {
         let i = r.checked_sub(base)? as usize;
-        (1..ME_CELLS + 1).contains(&i).then(|| offset + i - 1)
+        (1..cells + 1).contains(&i).then(|| offset + i - 1)
     };
     at(DEPTH, 0)
-        .or_else(|| at(DISCHARGE, ME_CELLS))
+        .or_else(|| at(DISCHARGE, cells))
         .map(Cell::State)
         .or_else(|| {
             at(DER_DEPTH, 0)
-                .or_else(|| at(DER_DISCHARGE, ME_CELLS))
+                .or_else(|| at(DER_DISCHARGE, cells))
                 .map(Cell::Derivative)
         })
 }
@@ -120,5 +127,24 @@ mod tests {
             .rposition(|v| !v.name.contains("swe."))
             .unwrap_or(0);
         assert_eq!(VARIABLES.len() - last - 1, 4 * ME_CELLS);
+    }
+
+    /// The numbering of the module's header, in a bank of 3 cells: swe.h[i] is position i - 1,
+    /// swe.q[i] is 3 + i - 1, each derivative the same position; nothing else is in the bank.
+    #[test]
+    fn a_bank_numbers_depths_then_discharges() {
+        let cells = 3;
+        for i in 1..=3u32 {
+            let k = i as usize - 1;
+            assert_eq!(cell_in(1000 + i, cells), Some(Cell::State(k)));
+            assert_eq!(cell_in(1500 + i, cells), Some(Cell::State(cells + k)));
+            assert_eq!(cell_in(2000 + i, cells), Some(Cell::Derivative(k)));
+            assert_eq!(cell_in(2500 + i, cells), Some(Cell::Derivative(cells + k)));
+        }
+        for r in [
+            0, 999, 1000, 1004, 1499, 1500, 1504, 1999, 2000, 2004, 2500, 2504, 3000,
+        ] {
+            assert_eq!(cell_in(r, cells), None, "vr {r}");
+        }
     }
 }
