@@ -460,6 +460,28 @@ fn s2s_indicators_are_the_gaps_and_an_impact_changes_the_states() {
     assert!(!update.states_changed);
 }
 
+/// base.v.jump is the host's total of the structure's velocity jumps (FMU.md): each event
+/// applies what is new since the last one, once. The impact mass in flight takes the jump in
+/// its relative velocity: 0.1, then nothing while the total stands, then the 0.2 more.
+#[test]
+fn base_velocity_jumps_are_taken_once_each() {
+    let more = [(vr::SLAMMING_CLEARANCE, 0.1), (vr::SLAMMING_OMEGA, 0.9)];
+    let mut tld = initialised(instance(SLAMMING, FIXED, 0.005, &more));
+    let mut s = states(&tld);
+    (s[4], s[5]) = (0.03, -0.2);
+    assert!(tld.set_states(&ct(), &s).is_ok());
+    let mut jumped = |total: f64| {
+        let before = states(&tld)[5];
+        set_real(&mut tld, Phase::EventMode, vr::BASE_V_JUMP, total);
+        assert!(tld.event_update(&context(Phase::EventMode)).is_ok());
+        states(&tld)[5] - before
+    };
+    let first = jumped(0.1);
+    close(first.abs(), 0.1, 1e-12, "the first jump");
+    assert_eq!(jumped(0.1), 0.0, "the same total again");
+    close(jumped(0.3), 2.0 * first, 1e-12, "what is new of the total");
+}
+
 /// Every Model Exchange function refuses before initialisation ("no simulation") and for a
 /// model ME does not offer (ShallowWater in a Co-Simulation instance, which may ask once
 /// terminated), saying why; states refused by the model (a runaway slosh.x) are an error that

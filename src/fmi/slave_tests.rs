@@ -301,6 +301,11 @@ fn input_derivatives_hold_for_one_step() {
         "x under a ramp",
     );
     assert_eq!(tld.a_derivatives, [0.0; 2]);
+    // Both derivatives set (neither 0): forgotten after the step all the same.
+    let both = d(&mut tld, &[vr::BASE_A, vr::BASE_A], &[1, 2], &[0.4, 3.0]);
+    assert_eq!(both.ok(), Some(Status::Ok));
+    assert_eq!(step(&mut tld, h, h).map_err(|e| e.message), Ok(false));
+    assert_eq!(tld.a_derivatives, [0.0; 2]);
 }
 
 /// The experiment's tolerance is kept within solver.tolerance's declared range [1e-14, 0.1].
