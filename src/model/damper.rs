@@ -31,7 +31,9 @@ pub struct Damper {
     amplitude: f64,
     /// Damping ratio in use.
     zeta: f64,
-    last_mean_force: Option<f64>,
+    /// The last step's impulse and length, the mean force formed when read
+    /// ([`MeanForce::get`]).
+    last_mean_force: MeanForce,
     /// Force of the liquid on the tanks [N] and the sloshing's displacement and velocity at the
     /// current state, kept with the state and indexed by their `Output` discriminants: a master
     /// reads them after every step, where they are loads.
@@ -88,7 +90,7 @@ impl Damper {
             damping_reads_amplitude: common.damping.reads_amplitude(),
             amplitude,
             zeta,
-            last_mean_force: None,
+            last_mean_force: MeanForce::NONE,
             noticed: false,
         };
         Ok((damper, warnings))
@@ -182,15 +184,12 @@ impl Damper {
             tracker.take_in(inputs.a, inputs.v);
         }
         self.per_step = [stepped.force, stepped.sloshing.0, stepped.sloshing.1];
-        // 1/h overflows for a subnormal h (and 0 x inf is NaN): over so short a step the mean
-        // force is the force. (Formed after the step: before it, 1/h would be kept in memory
-        // across the model's step.)
-        let mean_force = stepped.impulse * (1.0 / h);
-        self.last_mean_force = Some(if mean_force.is_finite() {
-            mean_force
-        } else {
-            stepped.force
-        });
+        // The mean force is formed when read: a division and a check on every step otherwise,
+        // whose result most hosts never ask for.
+        self.last_mean_force = MeanForce {
+            impulse: stepped.impulse,
+            h,
+        };
         // Far beyond the walls (twice their distance): most likely a unit mistake, in the input
         // or the tank, which `notice` explains. An implausible input drives the sloshing there
         // within a step or two.
@@ -258,7 +257,10 @@ impl Damper {
         let observe = |o| self.model.observe(o);
         match which {
             Output::X | Output::V | Output::Force => self.per_step_output(which).unwrap_or(0.0),
-            Output::ForceMean => self.last_mean_force.unwrap_or(self.force()),
+            Output::ForceMean => self
+                .last_mean_force
+                .get(self.force())
+                .unwrap_or(self.force()),
             Output::BaseShear => {
                 self.force()
                     - self.derived.mass_inactive * inputs.a
@@ -316,8 +318,9 @@ impl Damper {
         let mut out = Vec::with_capacity(self.model.state_len() + FRAME);
         self.model.save(&mut out);
         out.push(self.amplitude());
-        out.push(f64::from(u8::from(self.last_mean_force.is_some())));
-        out.push(self.last_mean_force.unwrap_or(0.0));
+        let mean_force = self.last_mean_force.get(self.force());
+        out.push(f64::from(u8::from(mean_force.is_some())));
+        out.push(mean_force.unwrap_or(0.0));
         out.extend_from_slice(
             &self
                 .tracker
@@ -360,8 +363,8 @@ impl Damper {
             damper.amplitude = frame[0];
         }
         damper.last_mean_force = match frame[1] {
-            0.0 => None,
-            1.0 => Some(frame[2]),
+            0.0 => MeanForce::NONE,
+            1.0 => MeanForce::of(frame[2]),
             _ => return Err("the state's mean-force flag is neither 0 nor 1".into()),
         };
         if let Some(tracker) = damper.tracker.as_mut() {
@@ -374,6 +377,42 @@ impl Damper {
         damper.model.set_damping(damper.zeta);
         damper.per_step = per_step(&damper.model);
         Ok(damper)
+    }
+}
+
+/// The last step's impulse on the tanks and its length: force.mean is their ratio, formed when
+/// read. No step yet: h = 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct MeanForce {
+    impulse: f64,
+    h: f64,
+}
+
+impl MeanForce {
+    const NONE: MeanForce = MeanForce {
+        impulse: 0.0,
+        h: 0.0,
+    };
+
+    /// The mean force `f` as a step of length 1 with the impulse `f` (f x 1/1 is f).
+    fn of(f: f64) -> Self {
+        MeanForce { impulse: f, h: 1.0 }
+    }
+
+    /// Whether a step has been taken.
+    fn is_some(&self) -> bool {
+        self.h != 0.0
+    }
+
+    /// The mean force over the last step, whose end has the force `force`; None before the
+    /// first step. Where impulse/h is not finite (1/h overflows for a subnormal h, and 0 x inf
+    /// is NaN) the step was too short for a mean: `force`.
+    fn get(&self, force: f64) -> Option<f64> {
+        if !self.is_some() {
+            return None;
+        }
+        let mean = self.impulse * (1.0 / self.h);
+        Some(if mean.is_finite() { mean } else { force })
     }
 }
 

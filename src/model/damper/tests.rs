@@ -261,6 +261,40 @@ fn a_subnormal_step_gives_finite_outputs() {
     }
 }
 
+/// force.mean: the force before the first step (the state's flag 0), the step's impulse over
+/// its length after one, the force after a step too short for a mean; the same bits restored.
+#[test]
+fn the_mean_force_is_formed_when_read_and_kept_with_the_state() {
+    for case in [defaults(), defaults().with(vr::MODEL, SHALLOW_WATER)] {
+        let p = case.with(vr::SLOSH_X0, 0.02);
+        let mut sim = damper(&p);
+        let flag = sim.model.state_len() + 1;
+        let mean = |sim: &Damper| sim.output(Output::ForceMean, &held(0.3)).to_bits();
+        assert_eq!(sim.snapshot()[flag..flag + 2], [0.0, 0.0], "{p:?}");
+        assert_eq!(mean(&sim), sim.force().to_bits(), "{p:?}: no step yet");
+        let x0 = sim.model.sloshing().0;
+        sim.step(0.0, 0.01, &held(0.3)).expect("step");
+        assert_ne!(
+            mean(&sim),
+            sim.force().to_bits(),
+            "{p:?}: a mean, not the end's force"
+        );
+        let (x1, f1) = (sim.model.sloshing().0, f64::from_bits(mean(&sim)));
+        // The mean force moves the sloshing mass the way the force does (opposite in sign).
+        assert!(f1 * (x1 - x0) < 0.0, "{p:?}: {f1} {x0} {x1}");
+        let restored = Damper::restore(&p, &sim.snapshot()).expect("restore");
+        assert_eq!(sim.snapshot()[flag..flag + 2], [1.0, f1], "{p:?}");
+        assert_eq!(mean(&restored), mean(&sim), "{p:?}: restored");
+        sim.step(0.01, 5e-324, &held(0.3))
+            .expect("a subnormal step");
+        assert_eq!(
+            mean(&sim),
+            sim.force().to_bits(),
+            "{p:?}: too short for a mean"
+        );
+    }
+}
+
 #[test]
 fn a_restored_state_has_the_damping_of_its_last_step() {
     // Tracked amplitude: the damping moves with every step, and the output derivatives read it
