@@ -181,11 +181,16 @@ impl AmplitudeTracker {
             self.restart_measured();
         }
         self.apply(alpha, decay, decay_m1, accel, velocity);
+        // At once here (a damping law that reads the estimate reads the weight every step).
+        let mut weight = self.weight();
+        weight.update(alpha, [1.0]);
+        self.weight.set(weight);
     }
 
-    /// The update proper, with the interval's coefficients and the velocity source settled:
-    /// the same operations whether a step is taken in at once ([`AmplitudeTracker::update`])
-    /// or after the model's step ([`AmplitudeTracker::take_in`]), so the same bits.
+    /// The update proper but for the weight, with the interval's coefficients and the velocity
+    /// source settled: the same operations whether a step is taken in at once
+    /// ([`AmplitudeTracker::update`]) or after the model's step ([`AmplitudeTracker::take_in`]),
+    /// so the same bits.
     #[inline(always)]
     fn apply(&mut self, alpha: f64, decay: f64, decay_m1: f64, accel: f64, velocity: f64) {
         let v = if self.measured_v_seen {
@@ -194,7 +199,6 @@ impl AmplitudeTracker {
             self.rebuilt_v
         };
         self.squares.update(alpha, [v * v, accel * accel]);
-        self.weight_pending.set(self.weight_pending.get() + 1);
         // Exact advance of v' = a - w_c v with a held.
         self.rebuilt_v = self.rebuilt_v * decay - accel * decay_m1 / self.leak;
     }
@@ -219,6 +223,7 @@ impl AmplitudeTracker {
             ..
         } = self.coefficients;
         self.apply(alpha, decay, decay_m1, accel, velocity);
+        self.weight_pending.set(self.weight_pending.get() + 1);
     }
 
     /// The coefficients for intervals of length `h`.
@@ -248,21 +253,28 @@ impl AmplitudeTracker {
     /// The weight filters now: the counted updates applied (and forgotten). Once an update
     /// leaves them as they are (the filters have reached 1, or as near as the gain's rounding
     /// lets them), so does every further one, and the rest are skipped.
+    #[inline(always)]
     fn weight(&self) -> MeanSquare<1> {
-        let mut weight = self.weight.get();
-        let pending = self.weight_pending.replace(0);
-        if pending > 0 {
-            let alpha = self.coefficients.alpha;
-            for _ in 0..pending {
-                let before = weight;
-                weight.update(alpha, [1.0]);
-                if weight == before {
-                    break;
-                }
-            }
-            self.weight.set(weight);
+        if self.weight_pending.get() > 0 {
+            self.settle_weight();
         }
-        weight
+        self.weight.get()
+    }
+
+    /// Apply the counted updates of the weight filters.
+    #[cold]
+    #[inline(never)]
+    fn settle_weight(&self) {
+        let mut weight = self.weight.get();
+        let alpha = self.coefficients.alpha;
+        for _ in 0..self.weight_pending.replace(0) {
+            let before = weight;
+            weight.update(alpha, [1.0]);
+            if weight == before {
+                break;
+            }
+        }
+        self.weight.set(weight);
     }
 
     /// Whether the host's base velocity `velocity` switches the estimator to it (it is not 0
