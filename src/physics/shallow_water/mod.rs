@@ -80,7 +80,7 @@ macro_rules! builds {
 #[cfg(test)]
 mod exact;
 mod lanes;
-mod reconstruction;
+pub mod reconstruction;
 pub mod scheme;
 pub mod screens;
 mod stages;

@@ -34,17 +34,17 @@ fn monotonised(left: f64, right: f64) -> f64 {
 /// What the limiting of a cell's slopes needs besides its differences: gravity, its inverse,
 /// and the thin depth (below it, minmod by component).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Limiting {
-    pub(super) g: f64,
-    pub(super) inv_g: f64,
-    pub(super) thin: f64,
+pub struct Limiting {
+    pub g: f64,
+    pub inv_g: f64,
+    pub thin: f64,
 }
 
 /// The faces of a cell of depth `depth` and velocity `u` from the differences of the surface
 /// w = H + z and of u across its left and right interfaces, `rise` the pseudo-bottom's rise
 /// from one cell to the next: (left depth, left velocity, right depth, right velocity).
 #[inline(always)]
-pub(super) fn faces_of(
+pub fn faces_of(
     depth: f64,
     u: f64,
     dw: [f64; 2],

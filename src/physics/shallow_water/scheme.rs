@@ -93,9 +93,9 @@ pub fn velocity(q: f64, h: f64, dry: f64) -> f64 {
 
 /// One side of an interface: depth and velocity.
 #[derive(Clone, Copy, Debug)]
-struct Side {
-    h: f64,
-    u: f64,
+pub struct Side {
+    pub h: f64,
+    pub u: f64,
 }
 
 /// HLL flux (mass, momentum) between `l` and `r` with Einfeldt's wave speeds, and the largest
@@ -108,7 +108,7 @@ struct Side {
 /// velocity's denominator), which changes no sign and so no case, and the HLL flux's
 /// denominator becomes D (S_R - S_L).
 #[inline(always)]
-fn hll(l: Side, r: Side, g: f64, root_g: f64, dry: f64) -> (f64, f64, f64) {
+pub fn hll(l: Side, r: Side, g: f64, root_g: f64, dry: f64) -> (f64, f64, f64) {
     let (wet_l, wet_r) = (l.h >= dry, r.h >= dry);
     // Square roots of the depths: the Roe weights, and times sqrt(g) the celerities.
     let (rl, rr) = (l.h.sqrt(), r.h.sqrt());
