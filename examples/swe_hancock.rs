@@ -22,6 +22,7 @@ use tld_fmu::description::vr;
 use tld_fmu::model::{Common, StartValues};
 use tld_fmu::physics::base::BaseAcceleration;
 use tld_fmu::physics::laws::DampingLaw;
+use tld_fmu::physics::shallow_water::lanes::{Survey, decayed, faster, lane_sum, settle};
 use tld_fmu::physics::shallow_water::reconstruction::{Limiting, faces_of};
 use tld_fmu::physics::shallow_water::scheme::{Side, hll, velocity};
 use tld_fmu::physics::shallow_water::{Channel, Flow, Scratch};
@@ -78,6 +79,8 @@ struct Hancock {
     mass: Vec<f64>,
     momentum: Vec<f64>,
     speed: Vec<f64>,
+    /// 1 where the predictor was skipped, per cell.
+    skip: Vec<f64>,
 }
 
 impl Hancock {
@@ -99,6 +102,7 @@ impl Hancock {
             mass: v(n + 1),
             momentum: v(n + 1),
             speed: v(n + 1),
+            skip: v(n),
         }
     }
 
@@ -165,7 +169,8 @@ impl Hancock {
     }
 
     /// One substep dt from t: drag dt/2, MUSCL-Hancock, drag dt/2. Ok(the largest interface
-    /// speed) or Err(it) when it exceeds the bound (nothing changed).
+    /// speed) or Err(it) when it exceeds the bound (nothing changed). In passes without
+    /// branches, as the model's sweep (so that the compiler vectorises them).
     #[inline(always)]
     fn substep(
         &mut self,
@@ -185,13 +190,9 @@ impl Hancock {
         };
         let h = &f.depth[..n];
         let decay = (-0.5 * c * dt).exp();
-        let q0 = &mut self.q0[..n];
-        let mut p0 = 0.0;
-        for (o, &q) in q0.iter_mut().zip(&f.discharge[..n]) {
-            p0 += q;
-            *o = q * decay;
-        }
-        let q0 = &*q0;
+        // The first drag half (U0's discharges) and the momentum before it.
+        let p0 = decayed(&f.discharge[..n], &mut self.q0[..n], decay);
+        let q0 = &self.q0[..n];
         // The reconstruction's and the predictor's input at t, the corrector's source the
         // mean over the substep (exact for the quadratic input: the momentum identity holds).
         let a0 = base.at(t);
@@ -202,115 +203,181 @@ impl Hancock {
             *u = velocity(q, h, dry);
         }
         let u = &*u;
+        let evolve = Evolve {
+            half: 0.5 * dt / dx,
+            g,
+            rise,
+            source: 0.5 * dt * a0,
+            dry,
+            thin,
+            conservative: self.predictor == Predictor::Conservative,
+        };
+        // The faces (cell i: ahead of interface i, behind interface i + 1) as the model's
+        // sweep forms them (at the walls with the mirror cell's differences), then evolved by
+        // dt/2. The edge cells first, then the interior in one loop.
         let (ahead_h, ahead_u) = (&mut self.ahead_h[..=n], &mut self.ahead_u[..=n]);
         let (behind_h, behind_u) = (&mut self.behind_h[..=n], &mut self.behind_u[..=n]);
-        // The faces (cell i: ahead of interface i, behind interface i + 1) as the model's
-        // sweep forms them, then evolved by dt/2.
-        let half = 0.5 * dt / dx;
-        let mut skipped = 0;
-        for i in 0..n {
-            let dw = [
-                if i == 0 { 0.0 } else { h[i] - h[i - 1] + rise },
-                if i == n - 1 {
-                    0.0
-                } else {
-                    h[i + 1] - h[i] + rise
-                },
-            ];
-            let du = [
-                if i == 0 { 2.0 * u[0] } else { u[i] - u[i - 1] },
-                if i == n - 1 {
-                    -2.0 * u[i]
-                } else {
-                    u[i + 1] - u[i]
-                },
-            ];
-            let (hl, ul, hr, ur) = faces_of(h[i], u[i], dw, du, rise, limiting);
-            let (dh, dv) = (hr - hl, ur - ul);
-            let (pl, vl, pr, vr) = match self.predictor {
-                Predictor::Primitive => {
-                    let dh_t = half * (u[i] * dh + h[i] * dv);
-                    let du_t = half * (u[i] * dv + g * (dh + rise));
-                    (hl - dh_t, ul - du_t, hr - dh_t, ur - du_t)
-                }
-                Predictor::Conservative => {
-                    let (ql, qr) = (hl * ul, hr * ur);
-                    let dm = half * (qr - ql);
-                    let dp = half * ((qr * ur + 0.5 * g * hr * hr) - (ql * ul + 0.5 * g * hl * hl))
-                        + 0.5 * dt * a0 * h[i];
-                    let (pl, pr) = (hl - dm, hr - dm);
-                    (
-                        pl,
-                        velocity(ql - dp, pl, dry),
-                        pr,
-                        velocity(qr - dp, pr, dry),
-                    )
-                }
-            };
-            let keep = pl >= thin && pr >= thin && h[i] >= thin;
-            skipped += u64::from(!keep);
-            let (pl, vl, pr, vr) = if keep {
-                (pl, vl, pr, vr)
-            } else {
-                (hl, ul, hr, ur)
-            };
-            (ahead_h[i], ahead_u[i], behind_h[i + 1], behind_u[i + 1]) = (pl, vl, pr, vr);
+        let skip = &mut self.skip[..n];
+        let last = n - 1;
+        for (i, dw, du) in [
+            (0, [0.0, h[1] - h[0] + rise], [2.0 * u[0], u[1] - u[0]]),
+            (
+                last,
+                [h[last] - h[last - 1] + rise, 0.0],
+                [u[last] - u[last - 1], -2.0 * u[last]],
+            ),
+        ] {
+            let faces = faces_of(h[i], u[i], dw, du, rise, limiting);
+            (
+                ahead_h[i],
+                ahead_u[i],
+                behind_h[i + 1],
+                behind_u[i + 1],
+                skip[i],
+            ) = evolve.of(h[i], u[i], faces);
+        }
+        let cells = ahead_h[1..last]
+            .iter_mut()
+            .zip(&mut ahead_u[1..last])
+            .zip(behind_h[2..n].iter_mut().zip(&mut behind_u[2..n]))
+            .zip(&mut skip[1..last]);
+        for ((((lh, lu), (rh, ru)), sk), (h, u)) in cells.zip(h.windows(3).zip(u.windows(3))) {
+            let faces = faces_of(
+                h[1],
+                u[1],
+                [h[1] - h[0] + rise, h[2] - h[1] + rise],
+                [u[1] - u[0], u[2] - u[1]],
+                rise,
+                limiting,
+            );
+            (*lh, *lu, *rh, *ru, *sk) = evolve.of(h[1], u[1], faces);
         }
         (behind_h[0], behind_u[0]) = (ahead_h[0], -ahead_u[0]);
         (ahead_h[n], ahead_u[n]) = (behind_h[n], -behind_u[n]);
+        // The corrector's fluxes between the evolved faces.
         let root_g = g.sqrt();
         let (mass, momentum, speed) = (
             &mut self.mass[..=n],
             &mut self.momentum[..=n],
             &mut self.speed[..=n],
         );
-        for k in 0..=n {
-            let l = Side {
-                h: behind_h[k],
-                u: behind_u[k],
-            };
-            let r = Side {
-                h: ahead_h[k],
-                u: ahead_u[k],
-            };
-            (mass[k], momentum[k], speed[k]) = hll(l, r, g, root_g, dry);
+        let out = mass
+            .iter_mut()
+            .zip(momentum.iter_mut())
+            .zip(speed.iter_mut());
+        let behind = behind_h.iter().zip(behind_u.iter());
+        let ahead = ahead_h.iter().zip(ahead_u.iter());
+        for (((f, m), s), ((&hl, &ul), (&hr, &ur))) in out.zip(behind.zip(ahead)) {
+            (*f, *m, *s) = hll(Side { h: hl, u: ul }, Side { h: hr, u: ur }, g, root_g, dry);
         }
         (mass[0], mass[n]) = (0.0, 0.0);
-        let fastest = speed.iter().fold(0.0f64, |m, &s| m.max(s));
+        let mut lanes = [0.0; 16];
+        let mut chunks = speed.chunks_exact(16);
+        for c in &mut chunks {
+            for (l, &s) in lanes.iter_mut().zip(c) {
+                *l = faster(*l, s);
+            }
+        }
+        for (l, &s) in lanes.iter_mut().zip(chunks.remainder()) {
+            *l = faster(*l, s);
+        }
+        let fastest = lanes.into_iter().fold(0.0, faster);
         if fastest * dt > COURANT_BOUND * dx {
             return Err(fastest);
         }
+        // The update; the source -a_b H with H the mean of the substep's ends: the sources
+        // sum to -a_b times the (conserved) volume, and the lake at rest keeps H.
         let lam = dt / dx;
+        let source = 0.5 * dt * am;
         let (next_h, next_q) = (&mut self.next_h[..n], &mut self.next_q[..n]);
-        let mut shallowest = f64::INFINITY;
-        for i in 0..n {
-            let hn = h[i] - lam * (mass[i + 1] - mass[i]);
-            // The source -a_b H with H the mean of the substep's ends: the sources sum to
-            // -a_b times the (conserved) volume, and the lake at rest keeps H.
-            next_q[i] = q0[i] - lam * (momentum[i + 1] - momentum[i]) - dt * am * 0.5 * (h[i] + hn);
-            next_h[i] = hn;
-            shallowest = shallowest.min(hn);
+        let next = next_h.iter_mut().zip(next_q.iter_mut());
+        let fluxes = mass.windows(2).zip(momentum.windows(2));
+        for (((nh, nq), (&h, &q)), (f, m)) in next.zip(h.iter().zip(q0)).zip(fluxes) {
+            let hn = h - lam * (f[1] - f[0]);
+            *nq = q - lam * (m[1] - m[0]) - source * (h + hn);
+            *nh = hn;
         }
-        let interior: f64 = mass[1..n].iter().sum();
+        let interior = lane_sum(&mass[1..n]);
         let impulse = (1.0 - decay) * p0 * dx + dt * (momentum[n] - momentum[0]);
+        let skipped = lane_sum(skip);
         std::mem::swap(&mut f.depth, &mut self.next_h);
         std::mem::swap(&mut f.discharge, &mut self.next_q);
-        let mut p1 = 0.0;
+        // The second drag half, the momentum before it, the shallowest depth; then the
+        // films, as the model: a dry cell's discharge goes to the bottom.
+        let Survey {
+            sum: p1,
+            shallowest,
+            ..
+        } = settle(&f.depth, &mut f.discharge, decay);
         let mut stopped = 0.0;
-        for (h, q) in f.depth.iter_mut().zip(f.discharge.iter_mut()) {
-            p1 += *q;
-            *q *= decay;
-            if *h < dry {
-                *h = h.max(0.0);
-                stopped += *q;
-                *q = 0.0;
+        if shallowest < dry {
+            for (h, q) in f.depth.iter_mut().zip(f.discharge.iter_mut()) {
+                if *h < dry {
+                    *h = h.max(0.0);
+                    stopped += *q;
+                    *q = 0.0;
+                }
             }
         }
         done.impulse += impulse + (1.0 - decay) * p1 * dx + stopped * dx;
         done.work -= dt * am * interior * dx;
-        done.skipped += skipped;
+        done.skipped += skipped as u64;
         done.shallowest = done.shallowest.min(shallowest);
         Ok(fastest)
+    }
+}
+
+/// The predictor: a cell's faces evolved by half a substep.
+#[derive(Clone, Copy, Debug)]
+struct Evolve {
+    /// dt/(2 dx).
+    half: f64,
+    g: f64,
+    /// The pseudo-bottom's rise from one cell to the next at t.
+    rise: f64,
+    /// dt/2 times a_b at t (the conservative predictor's source).
+    source: f64,
+    dry: f64,
+    thin: f64,
+    conservative: bool,
+}
+
+impl Evolve {
+    /// The faces (left depth, velocity, right depth, velocity) of a cell of depth `h` and
+    /// velocity `u` evolved by dt/2, and 1 where the predictor was skipped (the cell or an
+    /// evolved face thinner than `thin`: the faces at t are kept), else 0. Every case computed
+    /// and one selected (no branch).
+    #[inline(always)]
+    fn of(
+        &self,
+        h: f64,
+        u: f64,
+        (hl, ul, hr, ur): (f64, f64, f64, f64),
+    ) -> (f64, f64, f64, f64, f64) {
+        let (pl, vl, pr, vr) = if self.conservative {
+            let (ql, qr) = (hl * ul, hr * ur);
+            let dm = self.half * (qr - ql);
+            let flux = |h: f64, q: f64, u: f64| q * u + 0.5 * self.g * h * h;
+            let dp = self.half * (flux(hr, qr, ur) - flux(hl, ql, ul)) + self.source * h;
+            let (pl, pr) = (hl - dm, hr - dm);
+            (
+                pl,
+                velocity(ql - dp, pl, self.dry),
+                pr,
+                velocity(qr - dp, pr, self.dry),
+            )
+        } else {
+            let (dh, dv) = (hr - hl, ur - ul);
+            let dh_t = self.half * (u * dh + h * dv);
+            let du_t = self.half * (u * dv + self.g * (dh + self.rise));
+            (hl - dh_t, ul - du_t, hr - dh_t, ur - du_t)
+        };
+        let keep = pl >= self.thin && pr >= self.thin && h >= self.thin;
+        if keep {
+            (pl, vl, pr, vr, 0.0)
+        } else {
+            (hl, ul, hr, ur, 1.0)
+        }
     }
 }
 

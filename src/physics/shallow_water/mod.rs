@@ -79,7 +79,7 @@ macro_rules! builds {
 
 #[cfg(test)]
 mod exact;
-mod lanes;
+pub mod lanes;
 pub mod reconstruction;
 pub mod scheme;
 pub mod screens;
