@@ -5,8 +5,8 @@
 //! Toro, "Riemann solvers and numerical methods for fluid dynamics", ch. 14) instead of
 //! SSPRK(10,4): per substep the faces are reconstructed once, evolved by half a substep with
 //! the cell's own gradients (the predictor), and one HLL flux per interface is taken between
-//! the evolved faces (the corrector). Not the model: no screens, no films beyond the model's
-//! dry-cell stop, no outputs but force.mean and the balances.
+//! the evolved faces (the corrector); the screens split as the model splits them. Not the
+//! model: no films beyond the model's dry-cell stop, no outputs but force.mean and the balances.
 //!
 //! `cargo run --release --example swe_hancock -- accuracy [RATIOS] [CELLS] [COURANT] [PREDICTOR]`:
 //! the time-history and amplitude measures of examples/swe_accuracy.rs against its reference
@@ -17,13 +17,16 @@
 //!
 //! `cargo run --release --example swe_hancock -- rest [CELLS] [COURANT]`: the tilted lake at
 //! rest; `-- dambreak [COURANT]`: Ritter's and Stoker's dam breaks; `-- standing [COURANT]`:
-//! the smooth standing wave's order; `-- violent
+//! the smooth standing wave's order; `-- decay [COURANT]`: the linear free decay's frequency
+//! and damping (modes 1 and 3); `-- screens [COURANT]`: damping screens' decay and balances;
+//! `-- violent
 //! [CELLS] [COURANT] [SECONDS]`: resonant forcing that dries the bed (mass, positivity, momentum, energy).
 
 use tld_fmu::description::vr;
 use tld_fmu::model::{Common, StartValues};
 use tld_fmu::physics::base::BaseAcceleration;
 use tld_fmu::physics::laws::DampingLaw;
+use tld_fmu::physics::screens::loss_coefficient;
 use tld_fmu::physics::shallow_water::lanes::{Survey, decayed, faster, lane_sum, settle};
 use tld_fmu::physics::shallow_water::reconstruction::{Limiting, faces_of};
 use tld_fmu::physics::shallow_water::scheme::{Side, hll, velocity};
@@ -195,6 +198,13 @@ impl Hancock {
         let decay = (-0.5 * c * dt).exp();
         // The first drag half (U0's discharges) and the momentum before it.
         let p0 = decayed(&f.discharge[..n], &mut self.q0[..n], decay);
+        // The screens' first half after the drag's (each exact, Strang-symmetric overall, as
+        // the model): the discharge they take is their impulse on the tank.
+        let screens = !self.ch.screens.is_empty();
+        let mut taken = 0.0;
+        if screens {
+            taken += self.ch.screens.apply(h, &mut self.q0[..n], 0.5 * dt, dry) * dx;
+        }
         let q0 = &self.q0[..n];
         // The input's mean over the substep, in the reconstruction (the pseudo-bottom), the
         // predictor and the corrector's source: exact for the quadratic input, so the momentum
@@ -310,6 +320,13 @@ impl Hancock {
         let skipped = lane_sum(skip);
         std::mem::swap(&mut f.depth, &mut self.next_h);
         std::mem::swap(&mut f.discharge, &mut self.next_q);
+        if screens {
+            taken += self
+                .ch
+                .screens
+                .apply(&f.depth, &mut f.discharge, 0.5 * dt, dry)
+                * dx;
+        }
         // The second drag half, the momentum before it, the shallowest depth; then the
         // films, as the model: a dry cell's discharge goes to the bottom.
         let Survey {
@@ -327,7 +344,7 @@ impl Hancock {
                 }
             }
         }
-        done.impulse += impulse + (1.0 - decay) * p1 * dx + stopped * dx;
+        done.impulse += impulse + taken + (1.0 - decay) * p1 * dx + stopped * dx;
         done.work -= dt * am * interior * dx;
         done.skipped += skipped as u64;
         done.shallowest = done.shallowest.min(shallowest);
@@ -725,16 +742,7 @@ fn standing() -> Result<(), String> {
         for cells in [16, 32, 64, 128] {
             let (ch, _, _, _) = lab(cells)?;
             let amp = 1e-4 * ch.depth;
-            let k = std::f64::consts::PI / ch.length;
-            let start = Flow {
-                depth: (0..cells)
-                    .map(|i| {
-                        let (x0, x1) = (i as f64 * ch.dx(), (i + 1) as f64 * ch.dx());
-                        ch.depth + amp * ((k * x1).sin() - (k * x0).sin()) / (k * ch.dx())
-                    })
-                    .collect(),
-                discharge: vec![0.0; cells],
-            };
+            let start = standing_mode(&ch, 1.0, amp);
             let period = 2.0 * ch.length / (ch.g_e * ch.depth).sqrt();
             let mut f = start.clone();
             let held = BaseAcceleration::held(0.0);
@@ -761,6 +769,211 @@ fn standing() -> Result<(), String> {
         let name = predictor.map_or("committed".to_string(), |p| format!("{p:?}"));
         let errors: Vec<String> = errors.iter().map(|e| format!("{e:.2e}")).collect();
         println!("standing wave, {name}: L1 {errors:?}, orders {orders:.2?}");
+    }
+    Ok(())
+}
+
+/// Linear free decay (amplitude 1e-4 h) of mode `k` (1 or 3) in 64 cells with drag zeta, as the
+/// model's tests `linear_free_decay_gives_omega_1_and_the_drags_zeta` (k = 1, zeta 0.02, 6 s of
+/// 2 ms steps) and `third_mode_is_at_three_omega_1` (k = 3, no drag, 1 s of 1 ms steps) run it:
+/// the frequency from the first moment's upward zero crossings (undamped: / sqrt(1 - zeta^2))
+/// and, for the fundamental, zeta from the decay of its peaks; at the tests' steps and at
+/// 10 ms steps (Courant 0.9 reached). Bounds of the tests: (pi/64)^2 = 2.4e-3 relative for
+/// omega, absolute for zeta; (3 pi/64)^2 for the third mode.
+fn decay() -> Result<(), String> {
+    let courant: f64 = arg(2, &[0.9])?[0];
+    let cells = 64;
+    let (ch, _, _, omega) = lab(cells)?;
+    let pi = std::f64::consts::PI;
+    for (k, zeta, step, seconds) in [
+        (1.0, 0.02, 0.002, 6.0f64),
+        (1.0, 0.02, 0.01, 6.0),
+        (3.0, 0.0, 0.001, 1.0),
+        (3.0, 0.0, 0.01, 1.0),
+    ] {
+        let start = standing_mode(&ch, k, 1e-4 * ch.depth);
+        let steps = (seconds / step).round() as usize;
+        let c = 2.0 * zeta * omega;
+        let held = BaseAcceleration::held(0.0);
+        let mut line = format!("mode {k}, {step} s steps:");
+        for predictor in [Some(Predictor::Primitive), None] {
+            let mut f = start.clone();
+            let mut s = Hancock::new(ch, courant, Predictor::Primitive);
+            let mut series = vec![(0.0, ch.moment(&f))];
+            for j in 1..=steps {
+                match predictor {
+                    Some(_) => {
+                        s.advance(&mut f, step, &held, c);
+                    }
+                    None => {
+                        ch.advance(&mut f, step, &held, c, u64::MAX)
+                            .map_err(|e| format!("{e:?}"))?;
+                    }
+                }
+                series.push((j as f64 * step, ch.moment(&f)));
+            }
+            let ups: Vec<f64> = series
+                .windows(2)
+                .filter(|p| p[0].1 < 0.0 && p[1].1 >= 0.0)
+                .map(|p| p[0].0 - p[0].1 * (p[1].0 - p[0].0) / (p[1].1 - p[0].1))
+                .collect();
+            let n = ups.len() - 1;
+            let w = 2.0 * pi * n as f64 / (ups[n] - ups[0]);
+            let wn = w / (1.0 - zeta * zeta).sqrt();
+            let quarter = 0.5 * pi / w;
+            let peak = |t: f64| {
+                series
+                    .iter()
+                    .filter(|(s, _)| (s - t).abs() < quarter)
+                    .fold(0.0f64, |m, (_, v)| m.max(v.abs()))
+            };
+            let (t0, t1) = (ups[0] - quarter, ups[n] - quarter);
+            let measured = (peak(t0) / peak(t1)).ln() / (t1 - t0) / wn;
+            let name = predictor.map_or("committed", |_| "Hancock (primitive)");
+            line += &format!(
+                " {name}: omega {:+.2e} relative to {k} omega_1, zeta {measured:.5};",
+                wn / (k * omega) - 1.0
+            );
+        }
+        println!("{line}");
+    }
+    Ok(())
+}
+
+/// Mode `k` of height `amp` at the walls as cell averages of amp cos(k pi x/a), at rest.
+fn standing_mode(ch: &Channel, k: f64, amp: f64) -> Flow {
+    let wave = k * std::f64::consts::PI / ch.length;
+    let dx = ch.dx();
+    Flow {
+        depth: (0..ch.cells)
+            .map(|i| {
+                let (x0, x1) = (i as f64 * dx, (i + 1) as f64 * dx);
+                ch.depth + amp * ((wave * x1).sin() - (wave * x0).sin()) / (wave * dx)
+            })
+            .collect(),
+        discharge: vec![0.0; ch.cells],
+    }
+}
+
+/// One of the two schemes stepping a channel: MUSCL-Hancock (primitive) or the committed one.
+fn stepper(
+    ch: Channel,
+    courant: f64,
+    hancock: bool,
+) -> impl FnMut(&mut Flow, f64, &BaseAcceleration, f64) -> Done {
+    let mut s = Hancock::new(ch, courant, Predictor::Primitive);
+    let mut scratch = Scratch::new(ch.cells);
+    move |f, step, base, c| {
+        if hancock {
+            s.advance(f, step, base, c)
+        } else {
+            let a = ch
+                .advance_in(&mut scratch, f, step, base, c, u64::MAX)
+                .expect("the committed scheme steps");
+            Done {
+                impulse: a.impulse,
+                work: a.work,
+                ..Done::default()
+            }
+        }
+    }
+}
+
+/// Damping screens (Tait's pair at 0.4 a and 0.6 a), as the model's tests in
+/// src/physics/shallow_water/tests/screens.rs: the free decay from 1 % of h at the walls (2 ms
+/// steps, 4 s, no drag) against the closed-form equivalent damping per wave height
+/// (4/(3 pi^2)) C_l sum |sin(pi x_j/a)|^3 / h, the bare tank's decay subtracted, at 25-200
+/// cells (the test: within 2 %); and violent forcing (A = 0.005 and 0.05 m, 40 cells, 800
+/// steps of 10 ms, zeta 0.005): mass, the momentum identity with the screens' drag, and the
+/// smallest increment of dissipated energy (the test: never negative).
+fn screens() -> Result<(), String> {
+    let courant: f64 = arg(2, &[0.9])?[0];
+    let pi = std::f64::consts::PI;
+    for hancock in [true, false] {
+        let name = if hancock {
+            "Hancock (primitive)"
+        } else {
+            "committed"
+        };
+        let decay_rate = |ch: Channel, eta0: f64| -> f64 {
+            let mut step = stepper(ch, courant, hancock);
+            let mut f = standing_mode(&ch, 1.0, eta0);
+            let mut series = vec![(0.0, ch.moment(&f))];
+            for j in 1..=2000 {
+                step(&mut f, 0.002, &BaseAcceleration::held(0.0), 0.0);
+                series.push((j as f64 * 0.002, ch.moment(&f)));
+            }
+            // The peaks of each half cycle as 1/(wave height); their least-squares slope over
+            // omega_1 is zeta per wave height.
+            let p: Vec<(f64, f64)> = series
+                .windows(3)
+                .filter(|w| w[1].1.abs() >= w[0].1.abs() && w[1].1.abs() > w[2].1.abs())
+                .map(|w| {
+                    (
+                        w[1].0,
+                        2.0 * ch.length * ch.length / (pi * pi * w[1].1.abs()),
+                    )
+                })
+                .collect();
+            let n = p.len() as f64;
+            let mt = p.iter().map(|q| q.0).sum::<f64>() / n;
+            let my = p.iter().map(|q| q.1).sum::<f64>() / n;
+            let slope = p.iter().map(|q| (q.0 - mt) * (q.1 - my)).sum::<f64>()
+                / p.iter().map(|q| (q.0 - mt).powi(2)).sum::<f64>();
+            slope * ch.length / (pi * (ch.g_e * ch.depth).sqrt())
+        };
+        for s in [0.5, 0.7] {
+            let c_l = loss_coefficient(s);
+            let mut line = format!("{name}, screens S = {s}, free decay vs closed form:");
+            for cells in [25, 50, 100, 200] {
+                let bare = lab(cells)?.0;
+                let ch = bare.with_screens(&[0.4 * bare.length, 0.6 * bare.length], c_l);
+                let cubes = 2.0 * (0.4 * pi).sin().powi(3);
+                let expected = 4.0 / (3.0 * pi * pi) * c_l * cubes / ch.depth;
+                let measured =
+                    decay_rate(ch, 0.01 * ch.depth) - decay_rate(bare, 0.01 * bare.depth);
+                line += &format!(" {cells} cells {:+.4},", measured / expected - 1.0);
+            }
+            println!("{line}");
+        }
+        for amplitude in [0.005, 0.05] {
+            let bare = lab(40)?.0;
+            let (_, _, _, w) = lab(40)?;
+            let ch = bare.with_screens(
+                &[0.4 * bare.length, 0.6 * bare.length],
+                loss_coefficient(0.5),
+            );
+            let mut step = stepper(ch, courant, hancock);
+            let mut f = ch.at_rest();
+            let v = ch.volume(&f);
+            let (mut p0, mut input, mut last) = (0.0, 0.0, 0.0);
+            let (mut mass, mut residual, mut scale, mut least) =
+                (0.0f64, 0.0f64, 0.0f64, f64::INFINITY);
+            for k in 0..800 {
+                let t = k as f64 * 0.01;
+                let (sn, cs) = (w * t).sin_cos();
+                let a2 = amplitude * w * w;
+                let base = BaseAcceleration {
+                    t0: 0.0,
+                    a: [a2 * sn, a2 * w * cs, -a2 * w * w * sn],
+                };
+                let d = step(&mut f, 0.01, &base, 2.0 * 0.005 * w);
+                mass = mass.max((ch.volume(&f) / v - 1.0).abs());
+                let p1 = ch.momentum(&f);
+                residual = residual.max((d.impulse + v * base.integral(0.01) + (p1 - p0)).abs());
+                scale = scale.max(d.impulse.abs());
+                p0 = p1;
+                input += d.work;
+                let dissipated = input - ch.energy(&f);
+                least = least.min(dissipated - last);
+                last = dissipated;
+            }
+            println!(
+                "{name}, screens S = 0.5, violent A = {amplitude} m, 40 cells: mass {mass:.1e}, \
+                 momentum residual {residual:.1e} of impulses up to {scale:.1e}, smallest \
+                 dissipation increment {least:.2e}, dissipated {last:.3e}"
+            );
+        }
     }
     Ok(())
 }
@@ -845,6 +1058,10 @@ fn main() -> Result<(), String> {
         Some("dambreak") => dambreak(),
         Some("violent") => violent(),
         Some("standing") => standing(),
-        _ => Err("usage: swe_hancock accuracy|rest|dambreak|violent|standing [...]".into()),
+        Some("decay") => decay(),
+        Some("screens") => screens(),
+        _ => Err(
+            "usage: swe_hancock accuracy|rest|dambreak|violent|standing|decay|screens [...]".into(),
+        ),
     }
 }
