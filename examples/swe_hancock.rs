@@ -27,7 +27,7 @@ use tld_fmu::model::{Common, StartValues};
 use tld_fmu::physics::base::BaseAcceleration;
 use tld_fmu::physics::laws::DampingLaw;
 use tld_fmu::physics::screens::loss_coefficient;
-use tld_fmu::physics::shallow_water::lanes::{Survey, decayed, faster, lane_sum, settle};
+use tld_fmu::physics::shallow_water::lanes::{Survey, decayed, faster, lane_sum, settle, smaller};
 use tld_fmu::physics::shallow_water::reconstruction::{Limiting, faces_of};
 use tld_fmu::physics::shallow_water::scheme::{Side, hll, velocity};
 use tld_fmu::physics::shallow_water::screens::ScreenCells;
@@ -42,6 +42,8 @@ const SECONDS: f64 = 60.0;
 /// A substep whose interfaces meet a wave faster than this Courant number allows is taken
 /// again, shorter (MUSCL-Hancock is stable up to 1).
 const COURANT_BOUND: f64 = 1.0;
+/// The Courant number a substep whose corrector left a negative depth is taken again at.
+const POSITIVE_COURANT: f64 = 0.45;
 
 /// How the faces are evolved by half a substep.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -314,6 +316,20 @@ impl Hancock {
             let hn = h - (lam * f[1] - lam * f[0]);
             *nq = q - lam * (m[1] - m[0]) - source * (h + hn);
             *nh = hn;
+        }
+        // Positivity is not guaranteed at Courant numbers above 1/2: a substep whose corrector
+        // leaves a negative depth is taken again at POSITIVE_COURANT (by the speed that gives
+        // it, as a substep meeting a faster wave is).
+        let mut lanes = [f64::INFINITY; 8];
+        for c in next_h.chunks(8) {
+            for (l, &h) in lanes.iter_mut().zip(c) {
+                *l = smaller(*l, h);
+            }
+        }
+        if lanes.into_iter().fold(f64::INFINITY, smaller) < 0.0
+            && fastest * dt > POSITIVE_COURANT * dx * (1.0 + 1e-9)
+        {
+            return Err(fastest * self.courant / POSITIVE_COURANT);
         }
         let interior = lane_sum(&mass[1..n]);
         let impulse = (1.0 - decay) * p0 * dx + dt * (momentum[n] - momentum[0]);
