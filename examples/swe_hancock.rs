@@ -567,25 +567,11 @@ fn accuracy() -> Result<(), String> {
             (100.0 * ms.sqrt() / peak, 100.0 * (amp / r_amp - 1.0))
         };
         for &cells in &counts {
-            let mut scheme: Option<Hancock> = None;
-            let h = scene(cells, ratio, |ch, f, base, c| {
-                scheme
-                    .get_or_insert_with(|| Hancock::new(*ch, courant, predictor))
-                    .advance(f, STEP, base, c)
-            })?;
-            let mut scratch = Scratch::new(cells);
-            let m = scene(cells, ratio, |ch, f, base, c| {
-                let a = ch
-                    .advance_in(&mut scratch, f, STEP, base, c, u64::MAX)
-                    .expect("the committed scheme steps");
-                Done {
-                    impulse: a.impulse,
-                    work: a.work,
-                    substeps: a.substeps,
-                    rejected: a.rejected,
-                    ..Done::default()
-                }
-            })?;
+            let ch = lab(cells)?.0;
+            let mut hancock = stepper(ch, courant, Some(predictor));
+            let h = scene(cells, ratio, |_, f, base, c| hancock(f, STEP, base, c))?;
+            let mut committed = stepper(ch, courant, None);
+            let m = scene(cells, ratio, |_, f, base, c| committed(f, STEP, base, c))?;
             let steps = h.history.len() as f64;
             for (name, run) in [("hancock", &h), ("committed", &m)] {
                 let (rms, amp) = measure(&run.history);
@@ -762,15 +748,7 @@ fn standing() -> Result<(), String> {
             let period = 2.0 * ch.length / (ch.g_e * ch.depth).sqrt();
             let mut f = start.clone();
             let held = BaseAcceleration::held(0.0);
-            match predictor {
-                Some(p) => {
-                    Hancock::new(ch, courant, p).advance(&mut f, period, &held, 0.0);
-                }
-                None => {
-                    ch.advance(&mut f, period, &held, 0.0, u64::MAX)
-                        .map_err(|e| format!("{e:?}"))?;
-                }
-            }
+            stepper(ch, courant, predictor)(&mut f, period, &held, 0.0);
             let l1: f64 = f
                 .depth
                 .iter()
@@ -814,18 +792,10 @@ fn decay() -> Result<(), String> {
         let mut line = format!("mode {k}, {step} s steps:");
         for predictor in [Some(Predictor::Primitive), None] {
             let mut f = start.clone();
-            let mut s = Hancock::new(ch, courant, Predictor::Primitive);
+            let mut advance = stepper(ch, courant, predictor);
             let mut series = vec![(0.0, ch.moment(&f))];
             for j in 1..=steps {
-                match predictor {
-                    Some(_) => {
-                        s.advance(&mut f, step, &held, c);
-                    }
-                    None => {
-                        ch.advance(&mut f, step, &held, c, u64::MAX)
-                            .map_err(|e| format!("{e:?}"))?;
-                    }
-                }
+                advance(&mut f, step, &held, c);
                 series.push((j as f64 * step, ch.moment(&f)));
             }
             let ups: Vec<f64> = series
@@ -871,24 +841,26 @@ fn standing_mode(ch: &Channel, k: f64, amp: f64) -> Flow {
     }
 }
 
-/// One of the two schemes stepping a channel: MUSCL-Hancock (primitive) or the committed one.
+/// One of the two schemes stepping a channel: MUSCL-Hancock with `predictor`, or (None) the
+/// committed one (the model's `Channel::advance_in`).
 fn stepper(
     ch: Channel,
     courant: f64,
-    hancock: bool,
+    predictor: Option<Predictor>,
 ) -> impl FnMut(&mut Flow, f64, &BaseAcceleration, f64) -> Done {
-    let mut s = Hancock::new(ch, courant, Predictor::Primitive);
+    let mut s = predictor.map(|p| Hancock::new(ch, courant, p));
     let mut scratch = Scratch::new(ch.cells);
-    move |f, step, base, c| {
-        if hancock {
-            s.advance(f, step, base, c)
-        } else {
+    move |f, step, base, c| match &mut s {
+        Some(s) => s.advance(f, step, base, c),
+        None => {
             let a = ch
                 .advance_in(&mut scratch, f, step, base, c, u64::MAX)
                 .expect("the committed scheme steps");
             Done {
                 impulse: a.impulse,
                 work: a.work,
+                substeps: a.substeps,
+                rejected: a.rejected,
                 ..Done::default()
             }
         }
@@ -912,7 +884,7 @@ fn screens() -> Result<(), String> {
             "committed"
         };
         let decay_rate = |ch: Channel, eta0: f64| -> f64 {
-            let mut step = stepper(ch, courant, hancock);
+            let mut step = stepper(ch, courant, hancock.then_some(Predictor::Primitive));
             let mut f = standing_mode(&ch, 1.0, eta0);
             let mut series = vec![(0.0, ch.moment(&f))];
             for j in 1..=2000 {
@@ -959,7 +931,7 @@ fn screens() -> Result<(), String> {
                 &[0.4 * bare.length, 0.6 * bare.length],
                 loss_coefficient(0.5),
             );
-            let mut step = stepper(ch, courant, hancock);
+            let mut step = stepper(ch, courant, hancock.then_some(Predictor::Primitive));
             let mut f = ch.at_rest();
             let v = ch.volume(&f);
             let (mut p0, mut input, mut last) = (0.0, 0.0, 0.0);
