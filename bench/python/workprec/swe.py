@@ -158,8 +158,8 @@ def swe_section(result) -> list[str]:
     L.append(
         f"Cost per simulated second grows as cells^{k:.2f} (fit from 50 cells up): linear in the "
         "cells per substep, times the substeps: a substep is at most the 10 ms step and at most "
-        "2.7 dx over the fastest wave (0.45 per stage of SSPRK(10,4)), so one substep per step "
-        "up to about 100 cells here (cost linear in the cells), then substeps proportional to "
+        "0.9 dx over the fastest wave (MUSCL-Hancock at Courant 0.9), so one substep per step "
+        "up to about 35 cells here (cost linear in the cells), then substeps proportional to "
         "the cells (cost as cells², the column ns/s ÷ cells² then constant, up to the fixed cost "
         "per doStep).")
     if default is not None:

@@ -25,7 +25,7 @@
 //! being cut to |dH| <= 2 H), and with HLL fluxes whose speeds bound the face velocities
 //! (Einfeldt's: s_L <= u, s_R >= u of each side) the new depth is
 //! H' >= (1/2 - lam s) H_- + (1/2 - lam s) H_+ plus non-negative terms, lam s <= 1/2
-//! (Kurganov & Petrova 2007, section 3.2, for their central-upwind flux; HLL's is the same
+//! (the argument of Kurganov & Petrova 2007 for their central-upwind flux; HLL's has the same
 //! form). Round-off can still leave a drained cell a few ulps below 0: set to 0.
 
 /// One function compiled for several instruction sets: `$passes` (`#[inline(always)]`, any

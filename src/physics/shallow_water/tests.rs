@@ -301,7 +301,8 @@ fn vectorised_steps_are_bit_for_bit_the_baseline() {
 /// drying (the scheme is entropy stable in practice; the drag and the bores only take), from
 /// a coarse grid to the default's. (Under SSPRK3, whose quadrature of the work was exact only
 /// to cubics by the luck of Simpson's rule, the first step from rest created energy at 20
-/// cells; SSPRK(10,4)'s is fourth order.)
+/// cells; under MUSCL-Hancock it did with a_b at t instead of its mean over the substep in the
+/// reconstruction and the predictor.)
 #[test]
 fn dissipation_never_decreases() {
     for cells in [20, 40, 200] {
