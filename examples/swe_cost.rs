@@ -6,8 +6,9 @@
 //! rounds): per round the thread's CPU time (CLOCK_THREAD_CPUTIME_ID: other processes on the
 //! machine do not count, though they share its caches) over the whole run; the median and the
 //! least of the rounds per 10 ms doStep, the real-time factor that gives, the substeps per
-//! simulated second (taken or not), the time per cell and substep, the load average, and a hash
-//! of the final state (equal hashes: bit-identical results).
+//! simulated second (taken or not; how many of the run's were the positivity fallback's), the
+//! time per cell and substep, the load average, and a hash of the final state (equal hashes:
+//! bit-identical results).
 
 use tld_fmu::physics::base::BaseAcceleration;
 use tld_fmu::physics::geometry::Tank;
@@ -44,10 +45,10 @@ fn main() -> Result<(), String> {
     let h = 0.01;
     let steps = (seconds / h).round() as usize;
     let mut per_step = vec![];
-    let (mut substeps, mut hash) = (0, 0u64);
+    let (mut substeps, mut fallbacks, mut hash) = (0, 0, 0u64);
     for _ in 0..rounds.max(1) {
         let (mut flow, mut scratch) = (ch.at_rest(), Scratch::new(cells));
-        substeps = 0;
+        (substeps, fallbacks) = (0, 0);
         let started = cpu_seconds();
         for k in 0..steps {
             let (s, co) = (w * k as f64 * h).sin_cos();
@@ -60,6 +61,7 @@ fn main() -> Result<(), String> {
                 .advance_in(&mut scratch, &mut flow, h, &base, c, u64::MAX)
                 .map_err(|e| format!("step {k}: {e}"))?;
             substeps += done.substeps + done.rejected;
+            fallbacks += done.fallbacks;
         }
         per_step.push((cpu_seconds() - started) / steps as f64);
         hash = flow
@@ -78,7 +80,7 @@ fn main() -> Result<(), String> {
         .join(" ");
     println!(
         "{cells} cells, {seconds} s, {rounds} rounds: CPU per 10 ms doStep median {:.2} us (least \
-         {:.2}), {:.0}x real time, {:.0} substeps per s, {:.2} ns per cell and substep; load \
+         {:.2}), {:.0}x real time, {:.0} substeps per s ({fallbacks} in the run by the fallback), {:.2} ns per cell and substep; load \
          average {load}; state hash {hash:016x}",
         1e6 * median,
         1e6 * per_step[0],
