@@ -8,8 +8,8 @@ for the resolved liquid whatever the scheme's accuracy, checked from the outputs
 - mass: mass.inactive = 0 and base_shear = force (no rigidly moving liquid); the surface at the
   walls is where the liquid is (never below the bed).
 The scene: the lab tank near resonance at 6 mm of base motion (bores), boundary-layer damping,
-the input's derivatives passed (a quadratic polynomial over each step, which the scheme's
-Simpson-weighted stages integrate exactly)."""
+the input's derivatives passed (a quadratic polynomial over each step, whose mean over each
+substep the scheme integrates exactly)."""
 import numpy as np
 
 SHALLOW_WATER = 5

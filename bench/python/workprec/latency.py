@@ -116,6 +116,6 @@ def latency_section(res):
           "The error-controlled solvers (the defaults of the ODE models) take as many internal "
           "steps as the motion needs, so their tail grows with the excitation; a fixed-step "
           "solver (RK4, ExpRK4 with solver.fixed_step = dt) does the same work every step and "
-          "bounds it. ShallowWater's step grows as swe.cells^2 above about 100 cells (the "
+          "bounds it. ShallowWater's step grows as swe.cells^2 above about 35 cells (the "
           "section below).", ""]
     return L

@@ -1,5 +1,5 @@
 //! model = ShallowWater in Model Exchange: the semi-discrete scheme (the finite-volume spatial
-//! operator with the drag and the screens, [`Channel::semi_discrete`], without the SSPRK
+//! operator with the drag and the screens, [`Channel::semi_discrete`], without the MUSCL-Hancock
 //! substeps) as an ODE in the cells' depths and discharges, which a host's solver integrates.
 //!
 //! The number of continuous states is fixed by the model description (FMI 2.0) while

@@ -8,7 +8,7 @@ use super::{Common, Interval, Model, Observable, Output, Parameters, Start, Step
 use crate::description::vr;
 use crate::physics::laws::DampingLaw;
 use crate::physics::shallow_water::scheme::velocity;
-use crate::physics::shallow_water::{Channel, DRY, Flow, STAGE_COUNT, Scratch};
+use crate::physics::shallow_water::{Channel, DRY, Flow, Scratch};
 use crate::solver::SolveStats;
 use std::f64::consts::PI;
 
@@ -47,7 +47,7 @@ pub struct ShallowWater {
     storage: Storage,
 }
 
-/// Where a step is taken (the state stays as it was if the step is refused) and the stages'
+/// Where a step is taken (the state stays as it was if the step is refused) and the substep's
 /// storage: allocated once, not per step. It holds nothing from one step to the next: any two
 /// are equal, and a clone is a new one.
 #[derive(Debug)]
@@ -198,8 +198,8 @@ impl Model for ShallowWater {
         let stats = SolveStats {
             accepted: done.substeps,
             rejected: done.rejected,
-            // STAGE_COUNT right-hand sides per substep, taken or not.
-            evaluations: STAGE_COUNT * (done.substeps + done.rejected),
+            // One flux evaluation per substep, taken or not.
+            evaluations: done.substeps + done.rejected,
         };
         Ok(Stepped {
             stats,

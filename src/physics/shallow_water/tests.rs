@@ -122,10 +122,13 @@ fn dam_breaks_converge_to_ritter_and_stoker() {
         let errors = dam_break_errors(right);
         // A discontinuity (or a kink, at the dry front) is smeared over a fixed number of
         // cells whatever their width: first order in L1, a ratio of 2 per halving; order
-        // 0.8 (ratio 2^0.8 = 1.74) is asserted.
+        // 0.75 per halving and 0.85 over both are asserted. (0.8 per halving until
+        // MUSCL-Hancock: its Stoker errors, 6.4e-4, 3.1e-4, 1.8e-4, are below SSPRK(10,4)'s
+        // 7.6e-4, 3.5e-4, 1.9e-4 at every count, but fall at order 0.78 from 100 to 200.)
         for w in errors.windows(2) {
-            assert!(w[1] < w[0] / 2f64.powf(0.8), "{errors:?}");
+            assert!(w[1] < w[0] / 2f64.powf(0.75), "{errors:?}");
         }
+        assert!(errors[2] < errors[0] / 4f64.powf(0.85), "{errors:?}");
     }
 }
 
@@ -180,12 +183,18 @@ fn violent_sloshing_conserves_mass_and_stays_non_negative() {
     let mut worst: f64 = 0.0;
     let mut dry = 0usize;
     let mut lowest = f64::INFINITY;
-    for (f, _, _) in &run {
+    let (mut substeps, mut fallbacks) = (0, 0);
+    for (f, d, _) in &run {
+        substeps += d.substeps;
+        fallbacks += d.fallbacks;
         worst = worst.max((ch.volume(f) - v0).abs() / v0);
         dry += f.depth.iter().filter(|&&h| h < 1e-3 * ch.depth).count();
         lowest = lowest.min(f.depth.iter().copied().fold(f64::INFINITY, f64::min));
     }
-    eprintln!("violent: mass error {worst:e}, dry cell-steps {dry}, lowest {lowest:e}");
+    eprintln!(
+        "violent: mass error {worst:e}, dry cell-steps {dry}, lowest {lowest:e}, \
+         {fallbacks} of {substeps} substeps taken again by the fallback"
+    );
     assert!(lowest >= 0.0);
     assert!(dry > 0, "the run should dry the bed somewhere");
     assert!(worst < 1e-13, "{worst:e}");
@@ -212,10 +221,11 @@ fn impulse_closes_the_momentum_balance_every_step() {
     assert!(worst < 1e-13 * scale, "{worst:e} vs {scale:e}");
 }
 
-/// The right-hand side is the same bit for bit whichever build of its passes runs: the
-/// baseline, AVX2, AVX-512F (those this CPU has): no fused multiply-adds, nothing
-/// reassociated. At every state of a violent run, with bores and dry cells (`cargo test
-/// --release` tests the vectorised code; a debug build has none).
+/// The right-hand side and the substep's passes (MUSCL-Hancock and its fallback) are the same
+/// bit for bit whichever build of them runs: the baseline, AVX2, AVX-512F (those this CPU
+/// has): no fused multiply-adds, nothing reassociated. At every state of a violent run, with
+/// bores and dry cells (`cargo test --release` tests the vectorised code; a debug build has
+/// none).
 #[test]
 fn vectorised_passes_are_bit_for_bit_the_baseline() {
     let ch = lab(40);
@@ -232,15 +242,16 @@ fn vectorised_passes_are_bit_for_bit_the_baseline() {
             &f.depth,
             &f.discharge,
             a,
+            1e-3,
             &mut faces,
-            k % 3 == 0,
-            (k % 3 == 2).then_some(0.7),
-            &f.discharge,
-            |name, s, faces, march| {
+            |name, s, faces, steps| {
                 let (dh, dq) = faces.rates();
                 let all = dh.iter().chain(dq).chain(faces.mass_fluxes());
                 let all = all.chain(&s.wall).chain([&s.mass_flux, &s.speed]);
-                let all = all.chain(march.into_iter().flatten());
+                let all = all.chain(steps.iter().flat_map(|(s, next)| {
+                    let sweep = s.wall.iter().chain([&s.mass_flux, &s.speed]);
+                    sweep.chain(next.iter().copied().flatten())
+                }));
                 results.push((
                     name.to_string(),
                     all.map(|x| x.to_bits()).collect::<Vec<_>>(),
@@ -256,18 +267,33 @@ fn vectorised_passes_are_bit_for_bit_the_baseline() {
     assert!(dry > 0, "the run must dry cells");
 }
 
-/// The whole communication step (stages, updates, drag, films), compiled for each instruction
+/// The whole communication step (substeps, drag, screens, films), compiled for each instruction
 /// set, gives the same bits from every build: at each state of a violent run with dry cells,
-/// a 10 ms step with input derivatives from there.
+/// a 10 ms step with input derivatives from there; and from each state of a flow leaving a
+/// wall at 3 c0, whose steps take the positivity fallback.
 #[test]
 fn vectorised_steps_are_bit_for_bit_the_baseline() {
     let ch = lab(40);
     let w = omega_1(&ch);
     let run = violent(40, 300, 0.01, 0.1);
-    let mut builds = vec![];
-    for (k, (f, _, _)) in run.iter().enumerate().step_by(7) {
-        let base = harmonic(0.1, w, k as f64 * 0.01);
-        let results = ch.each_build(f, 0.01, &base, 0.3);
+    let mut draining = ch.at_rest();
+    draining
+        .discharge
+        .fill(3.0 * (ch.g_e * ch.depth).sqrt() * ch.depth);
+    let mut states: Vec<(Flow, BaseAcceleration)> = run
+        .iter()
+        .enumerate()
+        .step_by(7)
+        .map(|(k, (f, _, _))| (f.clone(), harmonic(0.1, w, k as f64 * 0.01)))
+        .collect();
+    for _ in 0..20 {
+        states.push((draining.clone(), held(0.0)));
+        ch.advance(&mut draining, 0.01, &held(0.0), 0.3, 1_000_000)
+            .expect("step");
+    }
+    let (mut builds, mut fallbacks) = (vec![], 0);
+    for (k, (f, base)) in states.iter().enumerate() {
+        let results = ch.each_build(f, 0.01, base, 0.3);
         let bits = |(_, r, g): &(&str, Result<Advanced, SolveError>, Flow)| {
             let d = r.as_ref().expect("step");
             let all = g
@@ -275,22 +301,26 @@ fn vectorised_steps_are_bit_for_bit_the_baseline() {
                 .iter()
                 .chain(&g.discharge)
                 .chain([&d.impulse, &d.work]);
-            (all.map(|x| x.to_bits()).collect::<Vec<_>>(), d.substeps)
+            let counts = (d.substeps, d.rejected, d.fallbacks);
+            (all.map(|x| x.to_bits()).collect::<Vec<_>>(), counts)
         };
         let first = bits(&results[0]);
         for r in &results[1..] {
-            assert_eq!(bits(r), first, "step {k}: {} against the baseline", r.0);
+            assert_eq!(bits(r), first, "state {k}: {} against the baseline", r.0);
         }
+        fallbacks += first.1.2;
         builds = results.iter().map(|r| r.0).collect();
     }
-    eprintln!("builds compared: {builds:?}");
+    eprintln!("builds compared: {builds:?}; {fallbacks} fallbacks among the steps");
+    assert!(fallbacks > 0);
 }
 
 /// Energy: dissipated = input - stored never decreases, step by step, through bores and
 /// drying (the scheme is entropy stable in practice; the drag and the bores only take), from
 /// a coarse grid to the default's. (Under SSPRK3, whose quadrature of the work was exact only
 /// to cubics by the luck of Simpson's rule, the first step from rest created energy at 20
-/// cells; SSPRK(10,4)'s is fourth order.)
+/// cells; under MUSCL-Hancock it did with a_b at t instead of its mean over the substep in the
+/// reconstruction and the predictor.)
 #[test]
 fn dissipation_never_decreases() {
     for cells in [20, 40, 200] {

@@ -11,7 +11,7 @@ use super::*;
 fn absurd_steps_are_refused() {
     let ch = lab(40);
     let mut f = mode(&ch, 1.0, 0.1 * ch.depth);
-    // A substep of 2.7 dx over the fastest wave is about 33 ms here: a 1 s step needs 30.
+    // A substep of 0.9 dx over the fastest wave is about 11 ms here: a 1 s step needs 90.
     let r = ch.advance(&mut f.clone(), 1.0, &held(0.0), 0.0, 10);
     assert!(
         matches!(r, Err(SolveError::TooManySteps { limit: 10, .. })),
@@ -79,17 +79,20 @@ fn a_film_above_the_dry_depth_is_liquid() {
     assert!(after > 0.5 * before, "{after:e} of {before:e}");
     assert_eq!(d.rejected, 0, "{d:?}");
     // The CFL speed of the cells sees the film's velocity: a step of 1 s is cut into substeps
-    // short enough from the start, none taken again.
+    // short enough from the start, none taken again for a faster wave (the wall cell the film
+    // leaves drains: there the positivity fallback takes substeps again).
+    let mut f = film.clone();
     let d = ch
-        .advance(&mut film.clone(), 1.0, &held(0.0), 0.0, 1_000)
+        .advance(&mut f, 1.0, &held(0.0), 0.0, 1_000)
         .expect("step");
-    assert!(d.substeps > 1 && d.rejected == 0, "{d:?}");
+    assert!(d.substeps > 1 && d.rejected == d.fallbacks, "{d:?}");
+    assert!(f.depth.iter().all(|&h| h >= 0.0), "{:?}", f.depth);
 }
 
 /// The substeps follow the CFL condition from the cells' speeds: still water, whose waves all
 /// run at c0 = sqrt(g_e h), takes ceil(h / (CFL dx / c0)) equal substeps, none taken again;
 /// and through the bores and dry walls of violent forcing, the cells' speed at the start of a
-/// step and the stages' speeds after keep retried substeps rare.
+/// step and the interfaces' speeds after keep retried substeps rare.
 #[test]
 fn substeps_follow_the_cfl_condition() {
     let ch = lab(40);
@@ -115,9 +118,10 @@ fn substeps_follow_the_cfl_condition() {
     assert!(rejected * 100 <= substeps, "{rejected} of {substeps}");
 }
 
-/// A substep whose stages meet a wave faster than the positivity bound allows is taken again,
-/// shorter: a dam break onto a dry bed, from rest, whose front runs at 2 c0 where the cells'
-/// speeds at the start are c0 at most; the depths stay non-negative.
+/// A substep whose interfaces meet a wave faster than the stability bound (Courant 1) allows is
+/// taken again, shorter: a dam break onto a dry bed, from rest, whose front runs at 2 c where
+/// the cells' speeds at the start are c at most (c of the dam's depth); the depths stay
+/// non-negative.
 #[test]
 fn a_substep_meeting_a_faster_wave_is_taken_again() {
     let ch = lab(50);
@@ -125,12 +129,12 @@ fn a_substep_meeting_a_faster_wave_is_taken_again() {
     for (i, h) in f.depth.iter_mut().enumerate() {
         *h = if i < 25 { 2.0 * ch.depth } else { 0.0 };
     }
-    // 50 ms: three substeps at the CFL step of c0 (2.7 dx / c0 = 21 ms), each stage's
-    // Courant number then 0.71 for the front.
+    // 50 ms: substeps at Courant 0.9 for c (0.9 dx / c = 7.1 ms), the front's Courant number
+    // then 1.8.
     let d = ch
         .advance(&mut f, 0.05, &held(0.0), 0.0, 1_000)
         .expect("step");
-    assert!(d.rejected >= 1, "{d:?}");
+    assert!(d.rejected > d.fallbacks, "{d:?}");
     assert!(f.depth.iter().all(|&h| h >= 0.0));
     assert!(f.depth[25] > 0.0, "the front has left the dam");
 }
@@ -249,4 +253,45 @@ fn one_cell_holds_still() {
         "{} vs {expected}",
         d.impulse
     );
+}
+
+/// Positivity is guaranteed by the fallback, not by MUSCL-Hancock: a flow leaving the left wall
+/// at 3 c0 (faster than the 2 c0 a rarefaction can follow: the bed behind it runs dry; it
+/// meets the right wall as a bore) drains the wall cells, where the predictor is skipped and
+/// the corrector at Courant up to 0.9 drives depths negative. Those
+/// substeps are taken again by the fallback; the depths stay non-negative, the volume is kept
+/// to round-off and the momentum balance closes, step by step.
+#[test]
+fn a_draining_wall_cell_is_kept_non_negative_by_the_fallback() {
+    for cells in [20, 50, 200] {
+        let ch = lab(cells);
+        let c0 = (ch.g_e * ch.depth).sqrt();
+        let mut f = ch.at_rest();
+        f.discharge.fill(3.0 * c0 * ch.depth);
+        let v0 = ch.volume(&f);
+        let (mut p0, mut fallbacks, mut substeps) = (ch.momentum(&f), 0, 0);
+        let (mut mass, mut residual, mut dry) = (0.0f64, 0.0f64, 0);
+        for _ in 0..100 {
+            let d = ch
+                .advance(&mut f, 0.01, &held(0.0), 0.0, 1_000_000)
+                .expect("step");
+            fallbacks += d.fallbacks;
+            substeps += d.substeps;
+            assert!(f.depth.iter().all(|&h| h >= 0.0), "{:?}", f.depth);
+            mass = mass.max((ch.volume(&f) / v0 - 1.0).abs());
+            let p1 = ch.momentum(&f);
+            residual = residual.max((d.impulse + (p1 - p0)).abs() / (v0 * c0));
+            p0 = p1;
+            dry += f.depth.iter().filter(|&&h| h < 1e-3 * ch.depth).count();
+        }
+        eprintln!(
+            "{cells} cells: {fallbacks} of {substeps} substeps by the fallback, {dry} cell-steps \
+             below 1e-3 h, volume {mass:e}, momentum residual {residual:e} of V c0"
+        );
+        // (Without the fallback the negative depths are set to 0: the volume grew by 5 % at 20
+        // cells.)
+        assert!(mass < 1e-14, "{cells} cells: {mass:e}");
+        assert!(residual < 1e-14, "{cells} cells: {residual:e}");
+        assert!(fallbacks > 0 && dry > 0, "{cells} cells");
+    }
 }
