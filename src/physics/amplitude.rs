@@ -8,8 +8,6 @@
 //! When the host never sets the base velocity, the velocity is rebuilt from the acceleration by
 //! a leaky integrator v' = a - w_c v, and its known gain w / sqrt(w^2 + w_c^2) is undone.
 
-use std::cell::Cell;
-
 /// Two cascaded first-order low-pass filters of each of `N` signals, sampled once per interval
 /// with the same gain: the same operations lane by lane, so that the signals' updates pack into
 /// one vector operation each (SSE2, NEON) with each lane's bits those of its own scalar update.
@@ -112,13 +110,8 @@ pub struct AmplitudeTracker {
     continuous: bool,
     /// The mean squares of the base velocity (lane `V`) and acceleration (lane `A`).
     squares: MeanSquare<2>,
-    /// The filters' response to a constant 1 (their normalisation), as of `weight_pending`
-    /// updates ago: it does not depend on the input, so a step only counts its update, and
-    /// [`AmplitudeTracker::weight`] applies the count when something reads it (the same
-    /// operations in the same order: the same bits).
-    weight: Cell<MeanSquare<1>>,
-    /// Updates of `weight`, each with the present coefficients' gain, not yet applied.
-    weight_pending: Cell<u64>,
+    /// The filters' response to a constant 1 (their normalisation).
+    weight: MeanSquare<1>,
     /// Derived from `h`, `tau` and `leak`: not part of what the tracker is.
     coefficients: Coefficients,
 }
@@ -139,7 +132,7 @@ impl PartialEq for AmplitudeTracker {
             other.prior_omega,
             other.rebuilt_v,
         ) && (self.measured_v_seen, self.continuous) == (other.measured_v_seen, other.continuous)
-            && (self.squares, self.weight()) == (other.squares, other.weight())
+            && (self.squares, self.weight) == (other.squares, other.weight)
     }
 }
 
@@ -157,8 +150,7 @@ impl AmplitudeTracker {
             measured_v_seen: false,
             continuous: false,
             squares: MeanSquare::default(),
-            weight: Cell::default(),
-            weight_pending: Cell::new(0),
+            weight: MeanSquare::default(),
             coefficients: Coefficients::NONE,
         }
     }
@@ -181,16 +173,11 @@ impl AmplitudeTracker {
             self.restart_measured();
         }
         self.apply(alpha, decay, decay_m1, accel, velocity);
-        // At once here (a damping law that reads the estimate reads the weight every step).
-        let mut weight = self.weight();
-        weight.update(alpha, [1.0]);
-        self.weight.set(weight);
     }
 
-    /// The update proper but for the weight, with the interval's coefficients and the velocity
-    /// source settled: the same operations whether a step is taken in at once
-    /// ([`AmplitudeTracker::update`]) or after the model's step ([`AmplitudeTracker::take_in`]),
-    /// so the same bits.
+    /// The update proper, with the interval's coefficients and the velocity source settled:
+    /// the same operations whether a step is taken in at once ([`AmplitudeTracker::update`])
+    /// or after the model's step ([`AmplitudeTracker::take_in`]), so the same bits.
     #[inline(always)]
     fn apply(&mut self, alpha: f64, decay: f64, decay_m1: f64, accel: f64, velocity: f64) {
         let v = if self.measured_v_seen {
@@ -199,6 +186,7 @@ impl AmplitudeTracker {
             self.rebuilt_v
         };
         self.squares.update(alpha, [v * v, accel * accel]);
+        self.weight.update(alpha, [1.0]);
         // Exact advance of v' = a - w_c v with a held.
         self.rebuilt_v = self.rebuilt_v * decay - accel * decay_m1 / self.leak;
     }
@@ -223,15 +211,12 @@ impl AmplitudeTracker {
             ..
         } = self.coefficients;
         self.apply(alpha, decay, decay_m1, accel, velocity);
-        self.weight_pending.set(self.weight_pending.get() + 1);
     }
 
     /// The coefficients for intervals of length `h`.
     #[cold]
     #[inline(never)]
     fn set_interval(&mut self, h: f64) {
-        // The counted updates were for the old interval's gain.
-        self.weight();
         self.coefficients = Coefficients {
             h,
             alpha: -(-h / self.tau).exp_m1(),
@@ -246,35 +231,7 @@ impl AmplitudeTracker {
     fn restart_measured(&mut self) {
         self.measured_v_seen = true;
         self.squares = MeanSquare::default();
-        self.weight = Cell::default();
-        self.weight_pending.set(0);
-    }
-
-    /// The weight filters now: the counted updates applied (and forgotten). Once an update
-    /// leaves them as they are (the filters have reached 1, or as near as the gain's rounding
-    /// lets them), so does every further one, and the rest are skipped.
-    #[inline(always)]
-    fn weight(&self) -> MeanSquare<1> {
-        if self.weight_pending.get() > 0 {
-            self.settle_weight();
-        }
-        self.weight.get()
-    }
-
-    /// Apply the counted updates of the weight filters.
-    #[cold]
-    #[inline(never)]
-    fn settle_weight(&self) {
-        let mut weight = self.weight.get();
-        let alpha = self.coefficients.alpha;
-        for _ in 0..self.weight_pending.replace(0) {
-            let before = weight;
-            weight.update(alpha, [1.0]);
-            if weight == before {
-                break;
-            }
-        }
-        self.weight.set(weight);
+        self.weight = MeanSquare::default();
     }
 
     /// Whether the host's base velocity `velocity` switches the estimator to it (it is not 0
@@ -332,7 +289,7 @@ impl AmplitudeTracker {
     pub fn continuous_rates(&self, accel: f64, velocity: f64) -> [f64; TRACKER_CONTINUOUS] {
         let v = self.velocity(velocity);
         let (first, second) = self.squares.rates(self.tau, [v * v, accel * accel]);
-        let ([w1], [w2]) = self.weight().rates(self.tau, [1.0]);
+        let ([w1], [w2]) = self.weight.rates(self.tau, [1.0]);
         [
             accel - self.leak * self.rebuilt_v,
             first[V],
@@ -379,8 +336,8 @@ impl AmplitudeTracker {
             self.squares.second[V],
             self.squares.first[A],
             self.squares.second[A],
-            self.weight().first[0],
-            self.weight().second[0],
+            self.weight.first[0],
+            self.weight.second[0],
         ]
     }
 
@@ -405,11 +362,10 @@ impl AmplitudeTracker {
             first: [s[2], s[4]],
             second: [s[3], s[5]],
         };
-        self.weight = Cell::new(MeanSquare {
+        self.weight = MeanSquare {
             first: [s[6]],
             second: [s[7]],
-        });
-        self.weight_pending.set(0);
+        };
     }
 
     /// The current amplitude estimate [m]: Co-Simulation's of the filters (a mean square or
@@ -419,7 +375,7 @@ impl AmplitudeTracker {
         if self.continuous {
             return self.continuous_estimate().0;
         }
-        let w = self.weight().second[0].max(0.0);
+        let w = self.weight.second[0].max(0.0);
         if w <= 0.0 {
             return self.prior;
         }
@@ -476,7 +432,7 @@ impl AmplitudeTracker {
     /// is the prior, its gradient 0.
     pub fn continuous_estimate(&self) -> (f64, [f64; TRACKER_CONTINUOUS]) {
         let [v0, a0] = self.prior_means();
-        let w = self.weight().second[0] + PRIOR_WEIGHT;
+        let w = self.weight.second[0] + PRIOR_WEIGHT;
         let v = self.squares.second[V] + PRIOR_WEIGHT * v0;
         let a = self.squares.second[A] + PRIOR_WEIGHT * a0;
         let mut gradient = [0.0; TRACKER_CONTINUOUS];
