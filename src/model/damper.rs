@@ -20,11 +20,12 @@ pub struct Damper {
     derived: Derived,
     model: AnyModel,
     tracker: Option<AmplitudeTracker>,
-    /// Whether the damping law reads the amplitude: only then is a tracked amplitude estimated
-    /// before each step. Otherwise the tracker takes in the step's input after the step, on the
-    /// fixed amplitude's path ([`Damper::step`]), and forms its estimate only when something
-    /// reads it (A_e.estimate, a saved state).
-    damping_reads_amplitude: bool,
+    /// Whether the amplitude is tracked and the damping law reads it: only then is the
+    /// amplitude estimated before each step. Otherwise a tracker takes in the step's input
+    /// after the step, on the fixed amplitude's path ([`Damper::step`]), and forms its estimate
+    /// only when something reads it (A_e.estimate, a saved state). One flag: one load and
+    /// branch before every step.
+    estimates_first: bool,
     /// Stored energy at the start [J]: counted as input.
     initial_energy: f64,
     /// The fixed amplitude, or a tracked one's prior (see [`Damper::amplitude`]).
@@ -80,6 +81,7 @@ impl Damper {
             mass_slosh,
             mass_inactive: mass_liquid - mass_slosh,
         };
+        let estimates_first = tracker.is_some() && common.damping.reads_amplitude();
         let damper = Damper {
             common,
             derived,
@@ -87,7 +89,7 @@ impl Damper {
             per_step: per_step(&model),
             model,
             tracker,
-            damping_reads_amplitude: common.damping.reads_amplitude(),
+            estimates_first,
             amplitude,
             zeta,
             last_mean_force: MeanForce::NONE,
@@ -106,38 +108,23 @@ impl Damper {
     /// this would add costs more than its body.
     #[inline(always)]
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
-        // A fixed amplitude was applied in configure. A tracked one that the damping law
-        // ignores takes in the step's input once the step has succeeded (all or nothing), on
-        // the same code as a fixed one: the input is read back from `inputs` after the model's
-        // step rather than kept (stored) across it. Anything else (the law reads the amplitude,
-        // a new interval length, the host's base.v appearing) is out of line.
-        let inline = match &self.tracker {
-            None => true,
-            Some(tracker) => !self.damping_reads_amplitude && tracker.takes_in_as_is(h, inputs.v),
-        };
-        if !inline {
+        // A fixed amplitude was applied in configure. A tracked amplitude that the damping law reads is estimated before the step, out of
+        // line; otherwise the tracker takes in the step's input once the step has succeeded
+        // (all or nothing), on the same code as a fixed amplitude, its rare cases (a new
+        // interval length, the host's base.v appearing) out of line in the update itself.
+        if self.estimates_first {
             return self.step_aside(t, h, inputs);
         }
         self.advance(self.zeta, t, h, inputs, true)
     }
 
-    /// [`Damper::step`] with a tracked amplitude, when the step's input is taken in at once:
-    /// before the step for a damping law that reads the amplitude (the step uses the tracker
-    /// as it will be after it), after it for one that ignores the amplitude when the tracker
-    /// cannot take it in as it is (a new interval length, the host's base.v appearing).
+    /// [`Damper::step`] for a damping law that reads a tracked amplitude: the step's input is
+    /// taken in before the step, which uses the tracker as it will be after it.
     #[inline(never)]
     fn step_aside(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
         let Some(tracker) = &self.tracker else {
             return self.advance(self.zeta, t, h, inputs, false);
         };
-        if !self.damping_reads_amplitude {
-            // (`advance` takes nothing in: `take_in` false.)
-            let report = self.advance(self.zeta, t, h, inputs, false)?;
-            if let Some(tracker) = self.tracker.as_mut() {
-                tracker.update(h, inputs.a, inputs.v);
-            }
-            return Ok(report);
-        }
         let mut tracker = tracker.clone();
         tracker.update(h, inputs.a, inputs.v);
         let zeta = self.common.zeta(tracker.estimate());
@@ -159,9 +146,9 @@ impl Damper {
             .map_or(self.amplitude, AmplitudeTracker::estimate)
     }
 
-    /// [`Damper::step`] with the damping ratio `zeta`: all but the amplitude tracker, which
-    /// only takes in the step's input (`take_in`) once the step has succeeded. Small (the
-    /// models' steps are out of line), so inlined.
+    /// [`Damper::step`] with the damping ratio `zeta`; the amplitude tracker, if `take_in`,
+    /// takes in the step's input once the step has succeeded. Small (the models' steps are out
+    /// of line), so inlined.
     #[inline(always)]
     fn advance(
         &mut self,
@@ -176,12 +163,19 @@ impl Damper {
         let a = [inputs.a, inputs.a_derivatives[0], inputs.a_derivatives[1]];
         let limit = 100.0 * self.common.tank.length;
         let stepped = self.model.step(t, h, zeta, a, limit)?;
-        // The tracker's part, the input read back through an opaque reference: kept in
-        // registers across the model's step it would be stored on the fixed amplitude's path
-        // too, and a store before the step costs that path time (docs/ARCHITECTURE.md).
+        // The tracker's part, the input read back from memory (volatile reads: the compiler may
+        // not keep it in registers across the model's step, where it would be spilled, stored
+        // on the fixed amplitude's path too, and a store before the step costs that path time;
+        // docs/ARCHITECTURE.md).
         if take_in && let Some(tracker) = self.tracker.as_mut() {
-            let inputs = std::hint::black_box(inputs);
-            tracker.take_in(inputs.a, inputs.v);
+            // SAFETY: reads of a valid reference's fields, as plain reads are.
+            let (a, v) = unsafe {
+                (
+                    std::ptr::read_volatile(&inputs.a),
+                    std::ptr::read_volatile(&inputs.v),
+                )
+            };
+            tracker.update(h, a, v);
         }
         self.per_step = [stepped.force, stepped.sloshing.0, stepped.sloshing.1];
         // The mean force is formed when read: a division and a check on every step otherwise,

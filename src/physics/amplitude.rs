@@ -28,11 +28,11 @@ impl<const N: usize> Default for MeanSquare<N> {
 
 impl<const N: usize> MeanSquare<N> {
     #[inline(always)]
-    fn update(&mut self, alpha: f64, sample: [f64; N]) {
-        for (first, s) in self.first.iter_mut().zip(sample) {
+    fn update(&mut self, alpha: [f64; N], sample: [f64; N]) {
+        for ((first, s), alpha) in self.first.iter_mut().zip(sample).zip(alpha) {
             *first += alpha * (s - *first);
         }
-        for (second, first) in self.second.iter_mut().zip(self.first) {
+        for ((second, first), alpha) in self.second.iter_mut().zip(self.first).zip(alpha) {
             *second += alpha * (first - *second);
         }
     }
@@ -80,8 +80,9 @@ pub const PRIOR_WEIGHT: f64 = 1e-6;
 struct Coefficients {
     /// The interval length they are for (NaN: none yet).
     h: f64,
-    /// The filters' gain 1 - e^(-h/tau).
-    alpha: f64,
+    /// The filters' gain 1 - e^(-h/tau), once per lane of the mean squares (one vector load,
+    /// not a load and a broadcast).
+    alpha: [f64; 2],
     /// The velocity rebuild's decay e^(-w_c h) and e^(-w_c h) - 1.
     decay: f64,
     decay_m1: f64,
@@ -90,7 +91,7 @@ struct Coefficients {
 impl Coefficients {
     const NONE: Coefficients = Coefficients {
         h: f64::NAN,
-        alpha: 0.0,
+        alpha: [0.0; 2],
         decay: 0.0,
         decay_m1: 0.0,
     };
@@ -160,8 +161,15 @@ impl AmplitudeTracker {
     /// filters); what changes rarely is out of line.
     #[inline(always)]
     pub fn update(&mut self, h: f64, accel: f64, velocity: f64) {
-        if self.coefficients.h != h {
-            self.set_interval(h);
+        // Both rare cases behind one branch, in integer bits: an interval length other than
+        // the coefficients' (h > 0: equal bits are equal lengths; NaN, no coefficients yet,
+        // equals none), or a base velocity other than +-0 (NaN included, as `!= 0.0` has it)
+        // while the estimator still rebuilds the velocity (the mask all ones until then).
+        let other_h = self.coefficients.h.to_bits() ^ h.to_bits();
+        let rebuilding = u64::from(self.measured_v_seen).wrapping_sub(1);
+        let new_velocity = (velocity.to_bits() << 1) & rebuilding;
+        if other_h | new_velocity != 0 {
+            self.settle(h, velocity);
         }
         let Coefficients {
             alpha,
@@ -169,48 +177,27 @@ impl AmplitudeTracker {
             decay_m1,
             ..
         } = self.coefficients;
-        if velocity != 0.0 && !self.measured_v_seen {
-            self.restart_measured();
-        }
-        self.apply(alpha, decay, decay_m1, accel, velocity);
-    }
-
-    /// The update proper, with the interval's coefficients and the velocity source settled:
-    /// the same operations whether a step is taken in at once ([`AmplitudeTracker::update`])
-    /// or after the model's step ([`AmplitudeTracker::take_in`]), so the same bits.
-    #[inline(always)]
-    fn apply(&mut self, alpha: f64, decay: f64, decay_m1: f64, accel: f64, velocity: f64) {
         let v = if self.measured_v_seen {
             velocity
         } else {
             self.rebuilt_v
         };
         self.squares.update(alpha, [v * v, accel * accel]);
-        self.weight.update(alpha, [1.0]);
+        self.weight.update([alpha[0]], [1.0]);
         // Exact advance of v' = a - w_c v with a held.
         self.rebuilt_v = self.rebuilt_v * decay - accel * decay_m1 / self.leak;
     }
 
-    /// Whether [`AmplitudeTracker::update`] over an interval of length `h` with the base
-    /// velocity `velocity` would be [`AmplitudeTracker::take_in`] alone: the coefficients are
-    /// for `h` and `velocity` does not switch the velocity source. Then a step's input can be
-    /// taken in after the step, on the step's own path, without either.
-    #[inline(always)]
-    pub fn takes_in_as_is(&self, h: f64, velocity: f64) -> bool {
-        self.coefficients.h == h && (velocity == 0.0 || self.measured_v_seen)
-    }
-
-    /// [`AmplitudeTracker::update`] where [`AmplitudeTracker::takes_in_as_is`] holds (for the
-    /// interval length and base velocity it was asked with), the same operations.
-    #[inline(always)]
-    pub fn take_in(&mut self, accel: f64, velocity: f64) {
-        let Coefficients {
-            alpha,
-            decay,
-            decay_m1,
-            ..
-        } = self.coefficients;
-        self.apply(alpha, decay, decay_m1, accel, velocity);
+    /// What an update over an interval of length `h` with the base velocity `velocity` needs
+    /// before the filters when it is not what the last one had: the coefficients for `h`, the
+    /// switch to the measured velocity.
+    #[cold]
+    #[inline(never)]
+    fn settle(&mut self, h: f64, velocity: f64) {
+        if self.coefficients.h != h {
+            self.set_interval(h);
+        }
+        self.sees_velocity(velocity);
     }
 
     /// The coefficients for intervals of length `h`.
@@ -219,7 +206,7 @@ impl AmplitudeTracker {
     fn set_interval(&mut self, h: f64) {
         self.coefficients = Coefficients {
             h,
-            alpha: -(-h / self.tau).exp_m1(),
+            alpha: [-(-h / self.tau).exp_m1(); 2],
             decay: (-self.leak * h).exp(),
             decay_m1: (-self.leak * h).exp_m1(),
         };
@@ -236,6 +223,7 @@ impl AmplitudeTracker {
 
     /// Whether the host's base velocity `velocity` switches the estimator to it (it is not 0
     /// and the estimator still rebuilds the velocity from the acceleration).
+    #[inline(always)]
     pub fn would_see_velocity(&self, velocity: f64) -> bool {
         velocity != 0.0 && !self.measured_v_seen
     }
