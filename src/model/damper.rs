@@ -122,20 +122,27 @@ impl Damper {
     /// taken in before the step, which uses the tracker as it will be after it.
     #[inline(never)]
     fn step_aside(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
-        let Some(tracker) = &self.tracker else {
+        let Some(tracker) = self.tracker.as_mut() else {
             return self.advance(self.zeta, t, h, inputs, false);
         };
-        let mut tracker = tracker.clone();
+        // Updated in place, the copy kept for a refused step: an update of a fresh copy would
+        // load what the copy has just stored, in other widths (a stall per load the processor
+        // cannot forward; NSD's defaults +12 % with the filters' gain as one vector load).
+        let before = tracker.clone();
         tracker.update(h, inputs.a, inputs.v);
         let zeta = self.common.zeta(tracker.estimate());
-        let report = self.advance(zeta, t, h, inputs, false)?;
-        if let Some(kept) = self.tracker.as_mut() {
-            *kept = tracker;
+        match self.advance(zeta, t, h, inputs, false) {
+            Ok(report) => {
+                // Only here does the damping ratio change (stored on the other paths, the
+                // same value stored on every step).
+                self.zeta = zeta;
+                Ok(report)
+            }
+            Err(e) => {
+                self.tracker = Some(before);
+                Err(e)
+            }
         }
-        // Only here does the damping ratio change (stored on the other paths, the same value
-        // stored on every step).
-        self.zeta = zeta;
-        Ok(report)
     }
 
     /// The excitation amplitude the damping law is given (A_e.estimate): the fixed one, or
