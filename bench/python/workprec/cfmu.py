@@ -1,5 +1,7 @@
 """The careful C FMU of the Nonlinear model (bench/c/tld_c.c, issue #29): compiled with gcc -O2
-for the benchmark's native runs, which time it through the same host and calls as TLD.fmu."""
+for the benchmark's native runs, which time it through the same host and calls as TLD.fmu, as
+it is and with the energies TLD.fmu also integrates (-DTLD_C_ENERGIES: energy.input and
+energy.dissipated, two more components of every stage), the same outputs as TLD.fmu's."""
 from __future__ import annotations
 
 import subprocess
@@ -12,13 +14,20 @@ FLAGS = ["-O2", "-shared", "-fPIC"]
 _built: dict = {}
 
 
-def c_fmu(work: Path) -> Path:
-    """The C FMU's shared library under `work`, compiled once per process."""
-    if "lib" not in _built:
-        out = work / "tld_c.so"
-        subprocess.run(["gcc", *FLAGS, "-o", str(out), str(SOURCE), "-lm"], check=True)
-        _built["lib"] = out
-    return _built["lib"]
+#: The two builds: (implementation name in the report, extra gcc flags, library file name).
+BUILDS = [("C FMU", [], "tld_c.so"),
+          ("C FMU, energies", ["-DTLD_C_ENERGIES"], "tld_c_energies.so")]
+
+
+def c_fmu(work: Path, energies: bool = False) -> Path:
+    """The C FMU's shared library under `work` (with the energies if `energies`), compiled once
+    per process."""
+    _, extra, name = BUILDS[int(energies)]
+    if name not in _built:
+        out = work / name
+        subprocess.run(["gcc", *FLAGS, *extra, "-o", str(out), str(SOURCE), "-lm"], check=True)
+        _built[name] = out
+    return _built[name]
 
 
 def c_tokens(fi, p):

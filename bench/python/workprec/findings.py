@@ -51,38 +51,14 @@ def observations(scenes, rows):
                  f"ns per doStep (median; range {min(diffs):.0f}–{max(diffs):.0f} ns), "
                  f"{np.median(ratios):.2f}× (range {min(ratios):.2f}–{max(ratios):.2f}×), on a "
                  f"plain loop of {min(loop):.0f}–{max(loop):.0f} ns per step: {verdict}.")
-    # the careful C FMU (bench/c/tld_c.c): same method and substeps, and the fronts at equal error
-    same, fronts, defaults = [], [], []
-    for sc in scenes:
-        for dt in sc.dts:
-            a = get(sc.key, dt, "TLD.fmu", "RK4", "n=1")
-            c = get(sc.key, dt, "C FMU", "RK4", "n=1")
-            if a and c:
-                same.append(a[0]["ns_step"] / c[0]["ns_step"])
-            pf = [(r["err"], r["ns_step"]) for r in get(sc.key, dt, "TLD.fmu") if not r["window"]]
-            pc = [(r["err"], r["ns_step"]) for r in get(sc.key, dt, "C FMU")]
-            res, _, wr = compare(pf, pc, True, 1.0)
-            concl = [r[3] for r in res if r[5]]
-            if concl:
-                fronts.append((sc.title.split(":")[0], dt, min(concl), max(concl)))
-            d = get(sc.key, dt, "TLD.fmu", "default")
-            if d and pc:
-                where, cc = cost_at(front(pc), d[0]["err"])
-                if where == "in":
-                    defaults.append(d[0]["ns_step"] / cc)
-    if same:
-        L.append(f"* **Against the careful C FMU** (`bench/c/tld_c.c`, gcc -O2, the same host and "
-                 f"calls). Same method, same substeps (RK4 n = 1, the same error): TLD.fmu "
-                 f"{np.median(same):.2f}× the C FMU's time per step (median over scenes and "
-                 f"steps; range {min(same):.2f}–{max(same):.2f}×)"
-                 + (f"; default settings against the C FMU's DormandPrince45 front at the same "
-                    f"error: {np.median(defaults):.2f}× (median; range {min(defaults):.2f}–"
-                    f"{max(defaults):.2f}×)" if defaults else "")
-                 + (f"; every TLD.fmu setting against the C FMU's front at equal error (best "
-                    f"to worst ratio per scene and step): "
-                    + "; ".join(f"{s}, {dt_label(dt)}: {lo:.2f}–{hi:.2f}×"
-                                for s, dt, lo, hi in fronts) if fronts else "")
-                 + ". Where the time goes: docs/ARCHITECTURE.md, *Costs that shaped the code*.")
+    # the careful C FMU (bench/c/tld_c.c), as it is and with the energies TLD.fmu integrates:
+    # same method and substeps, and the fronts at equal error
+    for impl, what in (("C FMU", "the C FMU"),
+                       ("C FMU, energies", "the C FMU with the energies TLD.fmu integrates "
+                        "(`-DTLD_C_ENERGIES`, the same outputs)")):
+        line = c_anchor(scenes, get, impl, what)
+        if line:
+            L.append(line)
     # error floor from the interval length
     floor = []
     for sc in scenes:
@@ -287,3 +263,41 @@ def targets(scenes, rows):
                      f"({fmt_ns(r[0]['ns_step'])} ns/step) | {v} |")
     summary["iv"] = ("PASS" if vs and all(v == "PASS" for v in vs) else "FAIL") if vs else "n/a"
     return dict(lines=lines, summary=summary)
+
+
+def c_anchor(scenes, get, impl, what):
+    """The findings' line on TLD.fmu against the C FMU build `impl` (described as `what`): RK4
+    n = 1 against the same, the default settings against its DormandPrince45 front at their
+    error, and every setting against its front at equal error; None without its rows."""
+    same, fronts, defaults = [], [], []
+    for sc in scenes:
+        for dt in sc.dts:
+            a = get(sc.key, dt, "TLD.fmu", "RK4", "n=1")
+            c = get(sc.key, dt, impl, "RK4", "n=1")
+            if a and c:
+                same.append(a[0]["ns_step"] / c[0]["ns_step"])
+            pf = [(r["err"], r["ns_step"]) for r in get(sc.key, dt, "TLD.fmu") if not r["window"]]
+            pc = [(r["err"], r["ns_step"]) for r in get(sc.key, dt, impl)]
+            res, _, wr = compare(pf, pc, True, 1.0)
+            concl = [r[3] for r in res if r[5]]
+            if concl:
+                fronts.append((sc.title.split(":")[0], dt, min(concl), max(concl)))
+            d = get(sc.key, dt, "TLD.fmu", "default")
+            if d and pc:
+                where, cc = cost_at(front(pc), d[0]["err"])
+                if where == "in":
+                    defaults.append(d[0]["ns_step"] / cc)
+    if not same:
+        return None
+    return (f"* **Against {what}** (`bench/c/tld_c.c`, gcc -O2, the same host and calls). Same "
+            f"method, same substeps (RK4 n = 1, the same error): TLD.fmu "
+            f"{np.median(same):.2f}× its time per step (median over scenes and steps; range "
+            f"{min(same):.2f}–{max(same):.2f}×)"
+            + (f"; default settings against its DormandPrince45 front at the same error: "
+               f"{np.median(defaults):.2f}× (median; range {min(defaults):.2f}–"
+               f"{max(defaults):.2f}×)" if defaults else "")
+            + (f"; every TLD.fmu setting against its front at equal error (best to worst ratio "
+               f"per scene and step): "
+               + "; ".join(f"{s}, {dt_label(dt)}: {lo:.2f}–{hi:.2f}×"
+                           for s, dt, lo, hi in fronts) if fronts else "")
+            + ". Where the time goes: docs/ARCHITECTURE.md, *Costs that shaped the code*.")

@@ -12,7 +12,7 @@ import numpy as np
 from tld_fmu.scenes import (TOLS, NATIVE_BIN, FmuInfo, Scene, n_steps, rel_err,
                             substep_counts)
 
-from .cfmu import c_fmu, c_tokens
+from .cfmu import BUILDS, c_fmu, c_tokens
 
 
 def run_native(fi: FmuInfo, sc: Scene, dt, a, refs, quick, tmp: Path):
@@ -55,20 +55,24 @@ def run_native(fi: FmuInfo, sc: Scene, dt, a, refs, quick, tmp: Path):
     rid = f"rust_RK4abs_{ns}"
     meta[rid] = dict(impl="Rust diagnostic", method="RK4 over (t+dt)-t", setting=f"n={ns}")
     lines.append(f"run {rid} rk4 sub={ns} span=abs")
-    # the careful C FMU (bench/c/tld_c.c) through the same host and calls: RK4 with the same
-    # substeps as TLD.fmu's, DormandPrince45 at the same tolerances
-    lines.append(f"lib {c_fmu(tmp)}")
+    # the careful C FMU (bench/c/tld_c.c) through the same host and calls, as it is and with
+    # the energies TLD.fmu integrates: RK4 with the same substeps as TLD.fmu's,
+    # DormandPrince45 at the same tolerances
     ctoks = c_tokens(fi, p)
-    for ns in substep_counts(dt, quick):
-        rid = f"c_RK4_{ns}"
-        meta[rid] = dict(impl="C FMU", method="RK4", setting=f"n={ns}")
-        lines.append(f"run {rid} fmu {' '.join(ctoks)} {fi.token('solver', 'RK4')} "
-                     f"{fi.token('solver.fixed_step', dt / ns)}")
-    for tol in (TOLS if not quick else [1e-6, 1e-10]):
-        rid = f"c_DP45_{tol:g}"
-        meta[rid] = dict(impl="C FMU", method="DP45", setting=f"tol={tol:g}")
-        lines.append(f"run {rid} fmu {' '.join(ctoks)} {fi.token('solver', 'DormandPrince45')} "
-                     f"{fi.token('solver.tolerance', tol)}")
+    for energies, (impl, _, _) in enumerate(BUILDS):
+        lines.append(f"lib {c_fmu(tmp, bool(energies))}")
+        tag = "cE" if energies else "c"
+        for ns in substep_counts(dt, quick):
+            rid = f"{tag}_RK4_{ns}"
+            meta[rid] = dict(impl=impl, method="RK4", setting=f"n={ns}")
+            lines.append(f"run {rid} fmu {' '.join(ctoks)} {fi.token('solver', 'RK4')} "
+                         f"{fi.token('solver.fixed_step', dt / ns)}")
+        for tol in (TOLS if not quick else [1e-6, 1e-10]):
+            rid = f"{tag}_DP45_{tol:g}"
+            meta[rid] = dict(impl=impl, method="DP45", setting=f"tol={tol:g}")
+            lines.append(f"run {rid} fmu {' '.join(ctoks)} "
+                         f"{fi.token('solver', 'DormandPrince45')} "
+                         f"{fi.token('solver.tolerance', tol)}")
     job = outdir / "jobs.txt"
     job.write_text("\n".join(lines) + "\n")
     proc = subprocess.run([str(NATIVE_BIN), str(job)], capture_output=True, text=True)
