@@ -36,7 +36,10 @@ impl Tld {
     /// value.
     #[inline(always)]
     pub(super) fn quick_reals<T>(&self, vrs: &[u32], out: &mut [T], to: fn(f64) -> T) -> bool {
-        let outputs = self.sim.as_ref().map_or(&NO_OUTPUTS, Damper::per_step);
+        let outputs = match &self.sim {
+            Some(sim) => sim.per_step(),
+            None => &NO_OUTPUTS,
+        };
         // Finite values sum to a finite value, but for an overflow (then the full path).
         let mut sum = 0.0;
         for (slot, &r) in out.iter_mut().zip(vrs) {

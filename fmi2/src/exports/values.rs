@@ -82,7 +82,7 @@ impl Access for Booleans {
 /// Our instance behind `c` if `call` passes quietly on it (its phase allows the call, no call
 /// logging) with `n` > 0 values in valid host arrays `vr` and `value`: what the quick paths of
 /// `get` and `set` assume. The checks of [`valid_array`], stricter on the length (values of 8
-/// bytes at most, up to 2^31 of them), once for both arrays.
+/// bytes at most, up to 2^30 of them), once for both arrays.
 ///
 /// # Safety
 /// `c` as for [`Instance::from_ptr`].
@@ -94,8 +94,9 @@ unsafe fn quiet<'a, S: Slave, R, V>(
     n: usize,
     value: *const V,
 ) -> Option<&'a mut Instance<S>> {
-    // Up to 2^31 values (any more: the full path, which takes up to isize::MAX bytes).
-    const QUICK_MAX: usize = 1 << 31;
+    // Up to 2^30 values (any more: the full path, which takes up to isize::MAX bytes): a
+    // bound the compiler tests in one compare (2^31 took it three instructions).
+    const QUICK_MAX: usize = 1 << 30;
     const { assert!(size_of::<R>() <= 8 && size_of::<V>() <= 8) };
     const { assert!(QUICK_MAX <= isize::MAX as usize / 8) };
     let arrays = n.wrapping_sub(1) < QUICK_MAX
