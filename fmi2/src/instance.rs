@@ -235,19 +235,12 @@ impl<S: Slave> Instance<S> {
 
     #[inline]
     pub fn do_step(&mut self, t: f64, h: f64) -> Reply {
-        // The refusals are made out of line from the values: a message formed here would keep
-        // t, h and the times in memory for its arguments on every step.
-        if !(crate::description::finite(h) && h > 0.0) {
-            return Err(step_refusal::size(h));
-        }
-        if !crate::description::finite(t) {
-            return Err(step_refusal::point(t));
-        }
         let now = self.context.time;
-        // Hosts accumulate time with rounding: accept a small mismatch, refuse a real one.
-        let slack = 1e-9 * now.abs().max(1.0) + 1e-6 * h;
-        if (t - now).abs() > slack {
-            return Err(step_refusal::jump(t, now));
+        // The usual step, told in a few instructions: h positive and finite, t within 1e-6 h of
+        // the FMU's time (so finite), which the checks of `step_refusal::check` accept too.
+        let usual = h > 0.0 && h <= f64::MAX && (t - now).abs() <= 1e-6 * h;
+        if !usual {
+            step_refusal::check(t, h, now)?;
         }
         if let Some(stop) = self.context.experiment.stop
             && t + h > stop + 1e-9 * stop.abs().max(1.0) + 1e-6 * h
@@ -359,9 +352,30 @@ impl<S: Slave> Instance<S> {
     }
 }
 
-/// fmi2DoStep's refusals of its arguments, out of line (see [`super::Instance::do_step`]).
+/// fmi2DoStep's checks of its arguments and their refusals, out of line (see
+/// [`super::Instance::do_step`]).
 mod step_refusal {
     use crate::status::{Refusal, refuse};
+
+    /// A step from `t` by `h` where the FMU's time is `now`: h positive and finite, t finite
+    /// and `now` but for the rounding of a host that accumulates time. The refusals are made
+    /// out of line from the values: a message formed here would keep t, h and the times in
+    /// memory for its arguments.
+    #[inline(never)]
+    pub fn check(t: f64, h: f64, now: f64) -> Result<(), Refusal> {
+        if !(crate::description::finite(h) && h > 0.0) {
+            return Err(size(h));
+        }
+        if !crate::description::finite(t) {
+            return Err(point(t));
+        }
+        // Hosts accumulate time with rounding: accept a small mismatch, refuse a real one.
+        let slack = 1e-9 * now.abs().max(1.0) + 1e-6 * h;
+        if (t - now).abs() > slack {
+            return Err(jump(t, now));
+        }
+        Ok(())
+    }
 
     #[cold]
     #[inline(never)]

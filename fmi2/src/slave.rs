@@ -87,14 +87,16 @@ pub trait Slave: Continuous {
         false
     }
 
-    /// The quick path of fmi2Get{Real,Integer,Boolean}: the value of `r` read as `ty` if it is
-    /// what [`Slave::get`] answers, in every phase that allows a get, with nothing to say (a
-    /// stored value, an output kept with the state); None: ask [`Slave::get`]. The default
-    /// answers none.
+    /// The quick path of fmi2Get{Real,Integer,Boolean}: the values of `vrs` read as `ty` into
+    /// `out` (as long), converted by `to`, and true if each is what [`Slave::get`] answers, in
+    /// every phase that allows a get, with nothing to say (a stored value, an output kept with
+    /// the state), and finite; false: ask [`Slave::get`] (which writes `out` again, or refuses).
+    /// One call for all the values: what every value needs (the simulation, the tables) is
+    /// found once. The default answers false.
     #[inline(always)]
-    fn get_quietly(&self, r: u32, ty: VarType) -> Option<f64> {
-        let _ = (r, ty);
-        None
+    fn get_quietly<T>(&self, vrs: &[u32], out: &mut [T], ty: VarType, to: fn(f64) -> T) -> bool {
+        let _ = (vrs, out, ty, to);
+        false
     }
 
     /// fmi2SetRealInputDerivatives, for the next step only.

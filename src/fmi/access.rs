@@ -6,10 +6,15 @@
 
 use fmi2_slave::{Context, Refusal, Reply, Status};
 
-use super::params::{Source, derived_value, free_real_input, source_of};
+use super::params::{
+    QUICK_NONE, QUICK_OUTPUT, QUICK_REALS, Source, derived_value, free_real_input, source_of,
+};
 use super::slave::{Ask, TABLE, Tld};
 use super::vars::{VARIABLES, VarType, finite, vr};
-use crate::model::{Damper, Output};
+use crate::model::{Damper, Output, PER_STEP};
+
+/// The per-step outputs before initialisation: not finite, which sends them the full path.
+static NO_OUTPUTS: [f64; PER_STEP + 1] = [f64::INFINITY; PER_STEP + 1];
 
 impl Tld {
     /// The value of `r` read as `ty` if it is a load: a stored value, or an output a master
@@ -22,6 +27,32 @@ impl Tld {
             Source::Output(which) => sim?.per_step_output(which),
             _ => None,
         }
+    }
+
+    /// [`fmi2_slave::Slave::get_quietly`] for Reals: one table look-up per value
+    /// ([`QUICK_REALS`]), the simulation found once, no branch but the loop's and the kind's.
+    /// A value reference with no quick read, and an output before initialisation, read
+    /// infinity, which the one finiteness test at the end turns away with any other non-finite
+    /// value.
+    #[inline(always)]
+    pub(super) fn quick_reals<T>(&self, vrs: &[u32], out: &mut [T], to: fn(f64) -> T) -> bool {
+        let outputs = match &self.sim {
+            Some(sim) => sim.per_step(),
+            None => &NO_OUTPUTS,
+        };
+        // Finite values sum to a finite value, but for an overflow (then the full path).
+        let mut sum = 0.0;
+        for (slot, &r) in out.iter_mut().zip(vrs) {
+            let code = usize::from(QUICK_REALS.get(r as usize).copied().unwrap_or(QUICK_NONE));
+            let v = match code.checked_sub(QUICK_OUTPUT.into()) {
+                // (PER_STEP + 1 is a power of two: a mask, no bounds check.)
+                Some(k) => outputs[k % outputs.len()],
+                None => self.values.at(code),
+            };
+            sum += v;
+            *slot = to(v);
+        }
+        finite(sum)
     }
 
     /// The value of `r` read as `ty` where it is no load, or why there is none.

@@ -2,7 +2,7 @@
 //! maps FMI variable names onto the simulation's inputs and outputs.
 
 use super::vars::{Causality, VARIABLES, VR_INDEX, VarType, Variability, index_of, vr};
-use crate::model::{Derived, Inputs, Output, Parameters};
+use crate::model::{Derived, InputAt, Inputs, Output, PER_STEP, Parameters};
 
 /// The variables of the first build with saved-state format version 1 (modelDescription.xml
 /// up to solver_id); variables added since are appended after them.
@@ -96,6 +96,19 @@ impl Values {
             // to the step's first stage (RK4 one substep: 57.9 -> 54.3 ns per step).
             v: std::hint::black_box(self.0[BASE_V]),
             a_derivatives,
+        }
+    }
+}
+
+impl Values {
+    /// Where base.a and base.v are, for [`crate::model::Damper::step_at`]: base.a is read
+    /// alone before the step (one 8-byte load, which the processor forwards from
+    /// fmi2SetReal's store just before), base.v only by an amplitude tracker.
+    #[inline(always)]
+    pub fn input_at(&self) -> InputAt<'_> {
+        InputAt {
+            a: &self.0[BASE_A],
+            v: &self.0[BASE_V],
         }
     }
 }
@@ -211,6 +224,32 @@ pub fn source_of(vr: u32, ty: VarType) -> Source {
     }
 }
 
+/// fmi2GetReal's quick read of `vr` (`Tld::quick_reals`), one code per value reference: i,
+/// the stored value at position i; [`QUICK_OUTPUT`] + k, the damper's per-step output k
+/// ([`crate::model::Damper::per_step`]), k = [`PER_STEP`] (its infinity) for none: the full
+/// path.
+/// The compiler builds it from [`REAL_SOURCES`].
+pub static QUICK_REALS: [u16; VR_INDEX.len()] = {
+    let mut table = [QUICK_NONE; VR_INDEX.len()];
+    let mut vr = 0;
+    while vr < table.len() {
+        table[vr] = match REAL_SOURCES[vr] {
+            Source::Stored(index) => {
+                assert!(index < QUICK_OUTPUT as usize);
+                index as u16
+            }
+            Source::Output(which) if (which as usize) < PER_STEP => QUICK_OUTPUT + which as u16,
+            _ => QUICK_NONE,
+        };
+        vr += 1;
+    }
+    table
+};
+
+/// The first code of a per-step output in [`QUICK_REALS`], and the code of none.
+pub const QUICK_OUTPUT: u16 = 0x8000;
+pub const QUICK_NONE: u16 = QUICK_OUTPUT + PER_STEP as u16;
+
 /// Where fmi2SetReal stores `vr` with no check but that the value is finite: a continuous Real
 /// input without bounds (a discrete one is set in event mode only: the full check; what `Instance::check_set` then checks, in every phase that allows sets).
 /// None for any other variable, which goes through the full check. A table the compiler
@@ -235,6 +274,10 @@ const FREE_REAL_INPUTS: [Option<u8>; VR_INDEX.len()] = {
     }
     table
 };
+
+// The quick setter stores a free input and nothing else (`Tld::set_quietly`): never the one
+// variable whose set raises a flag too (`Tld::put`).
+const _: () = assert!(FREE_REAL_INPUTS[vr::SOLVER_TOLERANCE as usize].is_none());
 
 /// [`FREE_REAL_INPUTS`] of `vr`.
 #[inline(always)]

@@ -107,12 +107,12 @@ impl Slave for Tld {
     #[inline]
     fn step(&mut self, _: &Context, t: f64, h: f64) -> Result<bool, Refusal> {
         debug_assert!(finite(t) && h > 0.0);
-        let inputs = self.values.inputs(self.a_derivatives);
+        let input = self.values.input_at();
         let sim = self
             .sim
             .as_mut()
             .ok_or_else(|| refuse("fmi2DoStep: no simulation (not initialised)"))?;
-        match sim.step(t, h, &inputs) {
+        match sim.step_at(t, h, self.a_derivatives, input) {
             Ok(report) => {
                 // Input derivatives describe one communication step. Reset only when set (any
                 // bit, -0 included): a store on every step otherwise.
@@ -182,7 +182,8 @@ impl Slave for Tld {
     fn set_quietly(&mut self, r: u32, value: f64, ty: vars::VarType) -> bool {
         match Self::free_input(r, value, ty) {
             Some(index) => {
-                self.put(r, index, value);
+                // An input, not solver.tolerance: no flag to set (`Tld::put`).
+                self.values.set_at(index, value);
                 true
             }
             None => false,
@@ -191,8 +192,24 @@ impl Slave for Tld {
 
     /// The stored values and the outputs kept with the state, as in [`Slave::get`].
     #[inline(always)]
-    fn get_quietly(&self, r: u32, ty: vars::VarType) -> Option<f64> {
-        self.loaded(self.sim.as_ref(), r, ty)
+    fn get_quietly<T>(
+        &self,
+        vrs: &[u32],
+        out: &mut [T],
+        ty: vars::VarType,
+        to: fn(f64) -> T,
+    ) -> bool {
+        if ty == vars::VarType::Real {
+            return self.quick_reals(vrs, out, to);
+        }
+        let sim = self.sim.as_ref();
+        for (slot, &r) in out.iter_mut().zip(vrs) {
+            match self.loaded(sim, r, ty) {
+                Some(v) if finite(v) => *slot = to(v),
+                _ => return false,
+            }
+        }
+        true
     }
 
     fn set_input_derivatives(

@@ -98,11 +98,10 @@ fn a_step_is_the_free_decay_and_every_output_reads_by_its_name() {
         close(real(&tld, p, vr::SLOSH_V), v, 1e-9, "slosh.v");
         let stored = 0.5 * m * (w * w * x * x + v * v);
         close(real(&tld, p, vr::ENERGY_STORED), stored, 1e-9, "energy");
-        // The outputs a master reads after every step take the quick path (Tld::loaded: a
-        // load, no call out of line), with the same value.
+        // The outputs a master reads after every step take the quick path (Tld::quick_reals:
+        // loads, no call out of line), with the same value.
         for r in [vr::FORCE, vr::SLOSH_X, vr::SLOSH_V] {
-            let quick = tld.get_quietly(r, VarType::Real);
-            assert_eq!(quick, Some(real(&tld, p, r)), "{r}");
+            assert_eq!(quick(&tld, r), Some(real(&tld, p, r)), "{r}");
         }
     }
     set_real(&mut tld, p, vr::BASE_A, 0.7);
@@ -244,13 +243,13 @@ fn sets_are_checked_first_and_the_user_tolerance_is_flagged() {
     assert!(tld.set_quietly(vr::BASE_X, 1e-3, VarType::Real));
     assert!(!tld.set_quietly(vr::BASE_V, f64::INFINITY, VarType::Real));
     assert!(!tld.set_quietly(vr::TANK_LENGTH, 0.7, VarType::Real));
-    assert_eq!(tld.get_quietly(vr::BASE_A, VarType::Real), Some(-2.5));
-    assert_eq!(tld.get_quietly(vr::BASE_X, VarType::Real), Some(1e-3));
-    assert_eq!(tld.get_quietly(vr::BASE_V, VarType::Real), Some(0.0));
-    assert_eq!(tld.get_quietly(vr::TANK_LENGTH, VarType::Real), Some(0.5));
+    assert_eq!(quick(&tld, vr::BASE_A), Some(-2.5));
+    assert_eq!(quick(&tld, vr::BASE_X), Some(1e-3));
+    assert_eq!(quick(&tld, vr::BASE_V), Some(0.0));
+    assert_eq!(quick(&tld, vr::TANK_LENGTH), Some(0.5));
     // A calculated parameter and an output before initialisation are no load.
-    assert_eq!(tld.get_quietly(vr::OMEGA_F, VarType::Real), None);
-    assert_eq!(tld.get_quietly(vr::SLOSH_X, VarType::Real), None);
+    assert_eq!(quick(&tld, vr::OMEGA_F), None);
+    assert_eq!(quick(&tld, vr::SLOSH_X), None);
     assert!(!tld.flag());
     assert_eq!(
         set(&mut tld, &[vr::SOLVER_TOLERANCE], &[1e-7]).ok(),
@@ -491,4 +490,51 @@ fn s2s_impulse_rides_in_the_saved_state() {
     let back = round_trip(&tld, ev).expect("restored");
     assert_eq!(real(&back, ev, vr::IMPACT_IMPULSE), impulse);
     assert_eq!(read(&back, ev, vr::IMPACTS), 1.0);
+}
+
+/// The quick path reads several values in one call, in the host's order, and answers false
+/// (the full path decides) as soon as one of them is no load or not finite: an unknown value
+/// reference, an output it does not keep, a calculated parameter, finite values whose sum
+/// overflows (the full path then hands them out).
+#[test]
+fn the_quick_path_reads_all_or_leaves_them_to_the_full_path() {
+    let p = Phase::StepComplete;
+    let mut tld = initialised(instance(LINEAR, FIXED, 0.005, &[]));
+    set_real(&mut tld, p, vr::BASE_A, 0.25);
+    assert_eq!(step(&mut tld, 0.0, 0.1).map_err(|e| e.message), Ok(false));
+    let vrs = [
+        vr::SLOSH_V,
+        vr::BASE_A,
+        vr::FORCE,
+        vr::SLOSH_X,
+        vr::TANK_LENGTH,
+    ];
+    let mut out = [0.0; 5];
+    assert!(tld.get_quietly(&vrs, &mut out, VarType::Real, |x| x));
+    let want = vrs.map(|r| real(&tld, p, r));
+    assert_eq!(out.map(f64::to_bits), want.map(f64::to_bits));
+    assert_eq!(out[1], 0.25);
+    let unknown = (0..u32::MAX).find(|&r| vars::index_of(r).is_none());
+    let unknown = unknown.expect("an unknown value reference");
+    for other in [vr::FORCE_MEAN, vr::OMEGA_F, unknown, u32::MAX] {
+        let vrs = [vr::SLOSH_X, other, vr::SLOSH_V];
+        let mut out = [0.0; 3];
+        assert!(
+            !tld.get_quietly(&vrs, &mut out, VarType::Real, |x| x),
+            "{other}"
+        );
+    }
+    // Finite, their sum not: the full path hands them out.
+    set_real(&mut tld, p, vr::BASE_A, f64::MAX);
+    set_real(&mut tld, p, vr::BASE_X, f64::MAX);
+    let vrs = [vr::BASE_A, vr::BASE_X];
+    assert!(!tld.get_quietly(&vrs, &mut [0.0; 2], VarType::Real, |x| x));
+    assert_eq!(vrs.map(|r| real(&tld, p, r)), [f64::MAX; 2]);
+}
+
+/// [`Slave::get_quietly`] of one Real: its value, or None (the full path).
+fn quick(tld: &Tld, r: u32) -> Option<f64> {
+    let mut out = [0.0];
+    tld.get_quietly(&[r], &mut out, VarType::Real, |x| x)
+        .then_some(out[0])
 }

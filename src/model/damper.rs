@@ -3,12 +3,17 @@
 //! energy at the start, and the frame of the saved state.
 
 use super::{
-    AmplitudeSource, AnyModel, Common, Derived, Inputs, Observable, Output, Parameters, Start,
-    StepError, choice,
+    AmplitudeSource, AnyModel, Common, Derived, InputAt, Inputs, Observable, Output, Parameters,
+    Start, StepError, choice,
 };
 use crate::description::vr;
 use crate::physics::amplitude::{AmplitudeTracker, TRACKER_STATE};
 use crate::solver::SolveStats;
+
+/// How many outputs [`Damper::per_step`] keeps: the `Output`s with discriminants below. Its
+/// array has one slot more, infinite: a read there finds no value (fmi2GetReal's quick path
+/// reads it for "none", with no branch). Infinite, not NaN: the damper still equals itself.
+pub const PER_STEP: usize = 3;
 
 /// Numbers of a saved state after the model's own: amplitude, mean force (flag and value),
 /// amplitude estimator.
@@ -37,8 +42,8 @@ pub struct Damper {
     last_mean_force: MeanForce,
     /// Force of the liquid on the tanks [N] and the sloshing's displacement and velocity at the
     /// current state, kept with the state and indexed by their `Output` discriminants: a master
-    /// reads them after every step, where they are loads.
-    per_step: [f64; 3],
+    /// reads them after every step, where they are loads. Then infinity ([`PER_STEP`]).
+    per_step: [f64; PER_STEP + 1],
     /// Whether the run has been told of implausible motion.
     noticed: bool,
 }
@@ -108,30 +113,54 @@ impl Damper {
     /// this would add costs more than its body.
     #[inline(always)]
     pub fn step(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
+        let input = InputAt {
+            a: &inputs.a,
+            v: &inputs.v,
+        };
+        self.step_at(t, h, inputs.a_derivatives, input)
+    }
+
+    /// [`Damper::step`] with base.a and base.v where they are (the host's values): nothing is
+    /// copied to memory for the step, and base.v is not read unless the amplitude tracker
+    /// takes it in.
+    #[inline(always)]
+    pub fn step_at(
+        &mut self,
+        t: f64,
+        h: f64,
+        a_derivatives: [f64; 2],
+        input: InputAt,
+    ) -> Result<Report, StepError> {
         // A fixed amplitude was applied in configure. A tracked amplitude that the damping law reads is estimated before the step, out of
         // line; otherwise the tracker takes in the step's input once the step has succeeded
         // (all or nothing), on the same code as a fixed amplitude, its rare cases (a new
         // interval length, the host's base.v appearing) out of line in the update itself.
         if self.estimates_first {
-            return self.step_aside(t, h, inputs);
+            return self.step_aside(t, h, a_derivatives, input);
         }
-        self.advance(self.zeta, t, h, inputs, true)
+        self.advance(self.zeta, t, h, a_derivatives, input, true)
     }
 
     /// [`Damper::step`] for a damping law that reads a tracked amplitude: the step's input is
     /// taken in before the step, which uses the tracker as it will be after it.
     #[inline(never)]
-    fn step_aside(&mut self, t: f64, h: f64, inputs: &Inputs) -> Result<Report, StepError> {
+    fn step_aside(
+        &mut self,
+        t: f64,
+        h: f64,
+        a_derivatives: [f64; 2],
+        input: InputAt,
+    ) -> Result<Report, StepError> {
         let Some(tracker) = self.tracker.as_mut() else {
-            return self.advance(self.zeta, t, h, inputs, false);
+            return self.advance(self.zeta, t, h, a_derivatives, input, false);
         };
         // Updated in place, the copy kept for a refused step: an update of a fresh copy would
         // load what the copy has just stored, in other widths (a stall per load the processor
         // cannot forward; NSD's defaults +12 % with the filters' gain as one vector load).
         let before = tracker.clone();
-        tracker.update(h, inputs.a, inputs.v);
+        tracker.update(h, *input.a, *input.v);
         let zeta = self.common.zeta(tracker.estimate());
-        match self.advance(zeta, t, h, inputs, false) {
+        match self.advance(zeta, t, h, a_derivatives, input, false) {
             Ok(report) => {
                 // Only here does the damping ratio change (stored on the other paths, the
                 // same value stored on every step).
@@ -162,29 +191,32 @@ impl Damper {
         zeta: f64,
         t: f64,
         h: f64,
-        inputs: &Inputs,
+        a_derivatives: [f64; 2],
+        input: InputAt,
         take_in: bool,
     ) -> Result<Report, StepError> {
         // Each step is integrated in its own time, 0 to h: the model is autonomous but for the
         // input, and (t + h) - t is not h in floating point.
-        let a = [inputs.a, inputs.a_derivatives[0], inputs.a_derivatives[1]];
+        let a = [*input.a, a_derivatives[0], a_derivatives[1]];
         let limit = 100.0 * self.common.tank.length;
         let stepped = self.model.step(t, h, zeta, a, limit)?;
-        // The tracker's part, the input read back from memory (volatile reads: the compiler may
-        // not keep it in registers across the model's step, where it would be spilled, stored
-        // on the fixed amplitude's path too, and a store before the step costs that path time;
-        // docs/ARCHITECTURE.md).
+        // The tracker's part, the input read back from where it is (volatile reads: the compiler
+        // may not keep it in registers across the model's step, where it would be spilled,
+        // stored on the fixed amplitude's path too, and a store before the step costs that path
+        // time; docs/ARCHITECTURE.md).
         if take_in && let Some(tracker) = self.tracker.as_mut() {
-            // SAFETY: reads of a valid reference's fields, as plain reads are.
+            // SAFETY: reads through valid references, as plain reads are.
             let (a, v) = unsafe {
                 (
-                    std::ptr::read_volatile(&inputs.a),
-                    std::ptr::read_volatile(&inputs.v),
+                    std::ptr::read_volatile(input.a),
+                    std::ptr::read_volatile(input.v),
                 )
             };
             tracker.update(h, a, v);
         }
-        self.per_step = [stepped.force, stepped.sloshing.0, stepped.sloshing.1];
+        // (The three, not the infinity after them: no store for it.)
+        let [force, x, v, _] = &mut self.per_step;
+        (*force, *x, *v) = (stepped.force, stepped.sloshing.0, stepped.sloshing.1);
         // The mean force is formed when read: a division and a check on every step otherwise,
         // whose result most hosts never ask for.
         self.last_mean_force = MeanForce {
@@ -241,7 +273,14 @@ impl Damper {
     /// with no call and nothing that can panic. None for the others.
     #[inline(always)]
     pub fn per_step_output(&self, which: Output) -> Option<f64> {
-        self.per_step.get(which as usize).copied()
+        self.per_step[..PER_STEP].get(which as usize).copied()
+    }
+
+    /// The outputs of [`Damper::per_step_output`], indexed by their `Output` discriminants
+    /// (those below [`PER_STEP`]), and infinity.
+    #[inline(always)]
+    pub fn per_step(&self) -> &[f64; PER_STEP + 1] {
+        &self.per_step
     }
 
     fn force(&self) -> f64 {
@@ -417,10 +456,11 @@ impl MeanForce {
     }
 }
 
-/// The outputs a master reads after every step, at the model's state, in `Output` order.
-fn per_step(model: &AnyModel) -> [f64; 3] {
+/// The outputs a master reads after every step, at the model's state, in `Output` order, and
+/// infinity.
+fn per_step(model: &AnyModel) -> [f64; PER_STEP + 1] {
     let (x, v) = model.sloshing();
-    [model.force(), x, v]
+    [model.force(), x, v, f64::INFINITY]
 }
 
 mod cells;

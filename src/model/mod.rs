@@ -21,7 +21,7 @@ pub mod slamming;
 mod wiring_tests;
 
 pub use common::{AmplitudeSource, Common, Derived};
-pub use damper::{Damper, Report, Unknown};
+pub use damper::{Damper, PER_STEP, Report, Unknown};
 pub use parameters::{Parameters, StartValues, choice};
 pub use registry::AnyModel;
 
@@ -37,6 +37,15 @@ pub struct Inputs {
     pub v: f64,
     /// First and second time derivatives of `a` at the step's start (0: held).
     pub a_derivatives: [f64; 2],
+}
+
+/// Where base.a and base.v are in memory for a step, a place that outlives it (the host's
+/// values, or an [`Inputs`]): [`Damper::step_at`] reads base.a from there before the step, and
+/// both again after it for the amplitude tracker, with nothing copied for the step.
+#[derive(Clone, Copy, Debug)]
+pub struct InputAt<'a> {
+    pub a: &'a f64,
+    pub v: &'a f64,
 }
 
 /// The outputs of the damper.

@@ -296,11 +296,18 @@ impl<const MARK: u64> Slave for Probe<MARK> {
         take
     }
     /// k and u as Reals, n as an Integer: stored values.
-    fn get_quietly(&self, r: u32, ty: VarType) -> Option<f64> {
-        match (r, ty) {
-            (K | U, Real) | (N, Integer) => Some(self.values[at(r)]),
-            _ => None,
+    fn get_quietly<T>(&self, vrs: &[u32], out: &mut [T], ty: VarType, to: fn(f64) -> T) -> bool {
+        for (slot, &r) in out.iter_mut().zip(vrs) {
+            let v = match (r, ty) {
+                (K | U, Real) | (N, Integer) => self.values[at(r)],
+                _ => return false,
+            };
+            if !v.is_finite() {
+                return false;
+            }
+            *slot = to(v);
         }
+        true
     }
     fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Reply {
         for ((&r, &order), &v) in vrs.iter().zip(orders).zip(values) {

@@ -17,6 +17,10 @@ use crate::status::{Reply, Status, refuse};
 trait Access {
     type Host: Copy;
     const TYPE: VarType;
+    /// fmi2Get and fmi2Set of this type (constants of the type: the out-of-line full paths then
+    /// take the host's arguments as they came, in the same registers).
+    const GET: &'static Call;
+    const SET: &'static Call;
     fn to_host(value: f64) -> Self::Host;
     fn from_host(value: Self::Host) -> f64;
     /// The values handed out, as reals (to be checked finite; Integers and Booleans always
@@ -34,6 +38,8 @@ struct Booleans;
 impl Access for Reals {
     type Host = fmi2Real;
     const TYPE: VarType = VarType::Real;
+    const GET: &'static Call = &calls::GET_REAL;
+    const SET: &'static Call = &calls::SET_REAL;
     #[inline(always)]
     fn to_host(value: f64) -> fmi2Real {
         value
@@ -50,6 +56,8 @@ impl Access for Reals {
 impl Access for Integers {
     type Host = fmi2Integer;
     const TYPE: VarType = VarType::Integer;
+    const GET: &'static Call = &calls::GET_INTEGER;
+    const SET: &'static Call = &calls::SET_INTEGER;
     fn to_host(value: f64) -> fmi2Integer {
         value as fmi2Integer
     }
@@ -61,6 +69,8 @@ impl Access for Integers {
 impl Access for Booleans {
     type Host = fmi2Boolean;
     const TYPE: VarType = VarType::Boolean;
+    const GET: &'static Call = &calls::GET_BOOLEAN;
+    const SET: &'static Call = &calls::SET_BOOLEAN;
     fn to_host(value: f64) -> fmi2Boolean {
         fmi2Boolean::from(value != 0.0)
     }
@@ -71,7 +81,8 @@ impl Access for Booleans {
 
 /// Our instance behind `c` if `call` passes quietly on it (its phase allows the call, no call
 /// logging) with `n` > 0 values in valid host arrays `vr` and `value`: what the quick paths of
-/// `get` and `set` assume.
+/// `get` and `set` assume. The checks of [`valid_array`], stricter on the length (values of 8
+/// bytes at most, up to 2^30 of them), once for both arrays.
 ///
 /// # Safety
 /// `c` as for [`Instance::from_ptr`].
@@ -83,25 +94,37 @@ unsafe fn quiet<'a, S: Slave, R, V>(
     n: usize,
     value: *const V,
 ) -> Option<&'a mut Instance<S>> {
+    // Up to 2^30 values (any more: the full path, which takes up to isize::MAX bytes): a
+    // bound the compiler tests in one compare (2^31 took it three instructions).
+    const QUICK_MAX: usize = 1 << 30;
+    const { assert!(size_of::<R>() <= 8 && size_of::<V>() <= 8) };
+    const { assert!(QUICK_MAX <= isize::MAX as usize / 8) };
+    let arrays = n.wrapping_sub(1) < QUICK_MAX
+        && !vr.is_null()
+        && vr.is_aligned()
+        && !value.is_null()
+        && value.is_aligned();
+    debug_assert!(!arrays || (valid_array(vr, n) && valid_array(value, n)));
+    if !arrays {
+        return None;
+    }
     // SAFETY: per the contract above.
     let inst = unsafe { Instance::<S>::from_ptr(c) }?;
-    let quiet = n > 0 && inst.passes_quietly(call) && valid_array(vr, n) && valid_array(value, n);
-    quiet.then_some(inst)
+    inst.passes_quietly(call).then_some(inst)
 }
 
 /// fmi2Get{Real,Integer,Boolean}: the quick path ([`Slave::get_quietly`]) when every value is
 /// a load and the call passes quietly, else the full one. The quick path needs no saved
-/// registers and no reply to carry: the full one is a call away.
+/// registers and no reply to carry: the full one is a call away, with the same arguments.
 #[inline(always)]
 unsafe fn get<S: Slave, A: Access>(
     c: fmi2Component,
-    call: &'static Call,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut A::Host,
 ) -> fmi2Status {
     // SAFETY: the host's component and arrays, checked there.
-    if let Some(inst) = unsafe { quiet::<S, _, _>(c, call, vr, nvr, value) } {
+    if let Some(inst) = unsafe { quiet::<S, _, _>(c, A::GET, vr, nvr, value) } {
         // SAFETY: host arrays of nvr elements, checked above.
         let (vrs, out) = unsafe {
             (
@@ -110,35 +133,26 @@ unsafe fn get<S: Slave, A: Access>(
             )
         };
         // A panic (none is expected) is left to the full path, which catches it.
-        let quietly = |r| catch_unwind(AssertUnwindSafe(|| inst.slave.get_quietly(r, A::TYPE)));
-        let mut done = true;
-        for (slot, &r) in out.iter_mut().zip(vrs) {
-            match quietly(r) {
-                // A value that is not finite goes the full path, which refuses it.
-                Ok(Some(v)) if v.is_finite() => *slot = A::to_host(v),
-                _ => {
-                    done = false;
-                    break;
-                }
-            }
-        }
-        if done {
+        let quietly = || inst.slave.get_quietly(vrs, out, A::TYPE, A::to_host);
+        if catch_unwind(AssertUnwindSafe(quietly)).unwrap_or(false) {
             return Status::Ok as fmi2Status;
         }
     }
     // SAFETY: the host's arguments, as handed over.
-    unsafe { get_in_full::<S, A>(c, call, vr, nvr, value) }
+    unsafe { get_in_full::<S, A>(c, vr, nvr, value) }
 }
 
-/// fmi2Get{Real,Integer,Boolean}, every case.
+/// fmi2Get{Real,Integer,Boolean}, every case. extern "C", with the export's arguments: it
+/// never unwinds (the guard catches every panic), so the quick path's call of it is a jump,
+/// with no frame of its own.
 #[inline(never)]
-unsafe fn get_in_full<S: Slave, A: Access>(
+unsafe extern "C" fn get_in_full<S: Slave, A: Access>(
     c: fmi2Component,
-    call: &'static Call,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut A::Host,
 ) -> fmi2Status {
+    let call = A::GET;
     guard::<S>(c, call, |inst| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, out) = unsafe {
@@ -162,14 +176,13 @@ unsafe fn get_in_full<S: Slave, A: Access>(
 #[inline(always)]
 unsafe fn set<S: Slave, A: Access>(
     c: fmi2Component,
-    call: &'static Call,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *const A::Host,
 ) -> fmi2Status {
     // SAFETY: as in `get`.
     if nvr == 1
-        && let Some(inst) = unsafe { quiet::<S, _, _>(c, call, vr, nvr, value) }
+        && let Some(inst) = unsafe { quiet::<S, _, _>(c, A::SET, vr, nvr, value) }
     {
         // SAFETY: host arrays of one element, checked above.
         let (r, v) = unsafe { (*vr, A::from_host(*value)) };
@@ -181,18 +194,18 @@ unsafe fn set<S: Slave, A: Access>(
         }
     }
     // SAFETY: the host's arguments, as handed over.
-    unsafe { set_in_full::<S, A>(c, call, vr, nvr, value) }
+    unsafe { set_in_full::<S, A>(c, vr, nvr, value) }
 }
 
-/// fmi2Set{Real,Integer,Boolean}, every case.
+/// fmi2Set{Real,Integer,Boolean}, every case (extern "C" as `get_in_full`).
 #[inline(never)]
-unsafe fn set_in_full<S: Slave, A: Access>(
+unsafe extern "C" fn set_in_full<S: Slave, A: Access>(
     c: fmi2Component,
-    call: &'static Call,
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *const A::Host,
 ) -> fmi2Status {
+    let call = A::SET;
     guard::<S>(c, call, |inst| {
         // SAFETY: host arrays of nvr elements.
         let (vrs, values) = unsafe {
@@ -214,7 +227,7 @@ pub unsafe fn fmi2GetReal<S: Slave>(
     value: *mut fmi2Real,
 ) -> fmi2Status {
     // SAFETY: the host's arguments, checked before use.
-    unsafe { get::<S, Reals>(c, &calls::GET_REAL, vr, nvr, value) }
+    unsafe { get::<S, Reals>(c, vr, nvr, value) }
 }
 
 #[inline(always)]
@@ -225,7 +238,7 @@ pub unsafe fn fmi2GetInteger<S: Slave>(
     value: *mut fmi2Integer,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { get::<S, Integers>(c, &calls::GET_INTEGER, vr, nvr, value) }
+    unsafe { get::<S, Integers>(c, vr, nvr, value) }
 }
 
 #[inline(always)]
@@ -236,7 +249,7 @@ pub unsafe fn fmi2GetBoolean<S: Slave>(
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { get::<S, Booleans>(c, &calls::GET_BOOLEAN, vr, nvr, value) }
+    unsafe { get::<S, Booleans>(c, vr, nvr, value) }
 }
 
 #[inline(always)]
@@ -247,7 +260,7 @@ pub unsafe fn fmi2SetReal<S: Slave>(
     value: *const fmi2Real,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { set::<S, Reals>(c, &calls::SET_REAL, vr, nvr, value) }
+    unsafe { set::<S, Reals>(c, vr, nvr, value) }
 }
 
 #[inline(always)]
@@ -258,7 +271,7 @@ pub unsafe fn fmi2SetInteger<S: Slave>(
     value: *const fmi2Integer,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { set::<S, Integers>(c, &calls::SET_INTEGER, vr, nvr, value) }
+    unsafe { set::<S, Integers>(c, vr, nvr, value) }
 }
 
 #[inline(always)]
@@ -269,7 +282,7 @@ pub unsafe fn fmi2SetBoolean<S: Slave>(
     value: *const fmi2Boolean,
 ) -> fmi2Status {
     // SAFETY: as above.
-    unsafe { set::<S, Booleans>(c, &calls::SET_BOOLEAN, vr, nvr, value) }
+    unsafe { set::<S, Booleans>(c, vr, nvr, value) }
 }
 
 /// This FMU has no String variables: any value reference is unknown.
