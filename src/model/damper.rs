@@ -131,10 +131,11 @@ impl Damper {
         a_derivatives: [f64; 2],
         input: InputAt,
     ) -> Result<Report, StepError> {
-        // A fixed amplitude was applied in configure. A tracked amplitude that the damping law reads is estimated before the step, out of
-        // line; otherwise the tracker takes in the step's input once the step has succeeded
-        // (all or nothing), on the same code as a fixed amplitude, its rare cases (a new
-        // interval length, the host's base.v appearing) out of line in the update itself.
+        // A fixed amplitude was applied in configure. A tracked amplitude that the damping law
+        // reads is estimated before the step, out of line; otherwise the tracker takes in the
+        // step's input once the step has succeeded (all or nothing), on the same code as a
+        // fixed amplitude, its rare cases (a new interval length, the host's base.v appearing)
+        // out of line in the update itself.
         if self.estimates_first {
             return self.step_aside(t, h, a_derivatives, input);
         }
