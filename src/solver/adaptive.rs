@@ -20,10 +20,12 @@ pub struct Controls<const N: usize> {
 }
 
 impl<const N: usize> Controls<N> {
-    /// RMS of the controlled components of `e`, each over its tolerance at y0 and y1.
-    pub fn norm(&self, e: &[f64; N], y0: &[f64; N], y1: &[f64; N]) -> f64 {
+    /// RMS of the controlled components of `e`, each over its tolerance at y0 and y1, among
+    /// the first `leading` (a right-hand side's [`Rhs::CONTROLLED`]: the rest have abs_scale 0).
+    #[inline(always)]
+    pub fn norm(&self, leading: usize, e: &[f64; N], y0: &[f64; N], y1: &[f64; N]) -> f64 {
         let (mut sum, mut n) = (0.0, 0usize);
-        for i in 0..N {
+        for i in 0..leading.min(N) {
             if self.abs_scale[i] > 0.0 {
                 let sc = self.rtol * (self.abs_scale[i] + y0[i].abs().max(y1[i].abs()));
                 sum += (e[i] / sc).powi(2);
@@ -155,8 +157,8 @@ fn initial_step<const N: usize, F: Rhs<N>>(
     span: f64,
 ) -> f64 {
     let zero = [0.0; N];
-    let d0 = ctl.norm(y, &zero, &zero);
-    let d1 = ctl.norm(f0, y, y);
+    let d0 = ctl.norm(F::CONTROLLED, y, &zero, &zero);
+    let d1 = ctl.norm(F::CONTROLLED, f0, y, y);
     // From rest the state says nothing of the time scale: let the second estimate decide.
     let h0 = if d0 < 1e-5 || d1 < 1e-5 {
         0.01 * span
@@ -173,7 +175,7 @@ fn initial_step<const N: usize, F: Rhs<N>>(
     for i in 0..N {
         df[i] = (f1[i] - f0[i]) / h0;
     }
-    let d2 = ctl.norm(&df, y, y);
+    let d2 = ctl.norm(F::CONTROLLED, &df, y, y);
     // Nothing moves: any step is exact, so take the whole interval.
     let h1 = if d1.max(d2) <= 1e-15 {
         span
@@ -199,6 +201,12 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
     t1: f64,
     y: &mut [f64; N],
 ) -> Result<SolveStats, SolveError> {
+    debug_assert!(
+        ctl.abs_scale[F::CONTROLLED.min(N)..]
+            .iter()
+            .all(|&s| s == 0.0),
+        "components past Rhs::CONTROLLED are not error-controlled"
+    );
     let span = t1 - t0;
     let mut stats = SolveStats::default();
     let mut z = *y;
@@ -229,7 +237,7 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
         let hs = if last { remaining } else { h };
         let ok = method.attempt(f, t, &z, hs, &mut y_new, &mut err, ctl, &mut stats);
         let e = if ok && all_finite(&y_new) {
-            ctl.norm(&err, &z, &y_new)
+            ctl.norm(F::CONTROLLED, &err, &z, &y_new)
         } else {
             f64::INFINITY
         };

@@ -342,7 +342,10 @@ impl<const N: usize> Embedded<N> for Dop853Stages<N> {
                 e3[i] += h * E3[j] * k[i];
             }
         }
-        let (n5, n3) = (ctl.norm(&e5, y, y_new), ctl.norm(&e3, y, y_new));
+        let (n5, n3) = (
+            ctl.norm(F::CONTROLLED, &e5, y, y_new),
+            ctl.norm(F::CONTROLLED, &e3, y, y_new),
+        );
         let denom = (n5 * n5 + 0.01 * n3 * n3).sqrt();
         let factor = if denom > 0.0 { n5 / denom } else { 0.0 };
         for i in 0..N {

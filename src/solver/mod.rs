@@ -19,6 +19,11 @@ pub use sdirk4::{Sdirk4, Sdirk4Stages};
 
 /// y' = f(t, y) for a state of fixed size N.
 pub trait Rhs<const N: usize> {
+    /// How many leading components error control may measure. The components past them are
+    /// quadratures that ride along, never error-controlled (abs_scale 0): known at compile
+    /// time, the error norm neither tests nor forms them.
+    const CONTROLLED: usize = N;
+
     fn eval(&self, t: f64, y: &[f64; N], dy: &mut [f64; N]);
 
     /// Magnitude of the fastest local time scale |lambda|max at (t, y), in 1/s. The default is

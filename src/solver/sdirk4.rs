@@ -85,7 +85,7 @@ where
                     z[i] += dz[i];
                 }
                 // Converged well below the step tolerance.
-                if ctl.norm(&dz_arr, &z, &z) < 1e-3 {
+                if ctl.norm(F::CONTROLLED, &dz_arr, &z, &z) < 1e-3 {
                     converged = true;
                     break;
                 }
