@@ -127,7 +127,23 @@ impl<const N: usize, M: Embedded<N>> Adaptive<N, M> {
 
     /// Advance `y` from `t0` to `t1` (> t0) to tolerance. On error `y` and the carried step
     /// size are left unchanged.
+    #[inline(never)]
     pub fn integrate<F: Rhs<N>>(
+        &mut self,
+        f: &F,
+        t0: f64,
+        t1: f64,
+        y: &mut [f64; N],
+    ) -> Result<SolveStats, SolveError> {
+        self.integrate_inlined(f, t0, t1, y)
+    }
+
+    /// [`Adaptive::integrate`] inlined into the caller, for a cheap explicit method: with the
+    /// caller's copy of the state and its checks in the same function, the stages and the
+    /// state stay in registers (an implicit method's linear algebra is better left where the
+    /// compiler puts it).
+    #[inline(always)]
+    pub fn integrate_inlined<F: Rhs<N>>(
         &mut self,
         f: &F,
         t0: f64,
@@ -192,6 +208,7 @@ fn initial_step<const N: usize, F: Rhs<N>>(
 
 /// Advance `y` from `t0` to `t1` (> t0) to tolerance with `method`, starting from the carried
 /// step `*h_next` (0: choose). On error `y` and `*h_next` are left unchanged.
+#[inline(always)]
 fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
     method: &mut M,
     ctl: &Controls<N>,

@@ -117,11 +117,13 @@ impl<const N: usize> Default for DormandPrince<N> {
 impl<const N: usize> Embedded<N> for DormandPrince<N> {
     const ORDER: f64 = 5.0;
 
+    #[inline(always)]
     fn begin<F: Rhs<N>>(&mut self, f: &F, t: f64, y: &[f64; N], f0: &mut [f64; N]) {
         f.eval(t, y, &mut self.k1);
         *f0 = self.k1;
     }
 
+    #[inline(always)]
     fn attempt<F: Rhs<N>>(
         &mut self,
         f: &F,
@@ -146,6 +148,7 @@ impl<const N: usize> Embedded<N> for DormandPrince<N> {
         all_finite(k7)
     }
 
+    #[inline(always)]
     fn accepted(&mut self) {
         self.k1 = self.k7;
     }
