@@ -2,7 +2,7 @@
 //! its error estimate; this driver chooses step sizes, lands exactly on the interval's end,
 //! bounds the work and carries the step size to the next interval.
 
-use super::{Rhs, SolveError, SolveStats, all_finite};
+use super::{Rhs, SolveError, SolveStats, all_finite_in};
 
 /// Error tolerance and work bounds of an adaptive integrator.
 #[derive(Clone, Debug, PartialEq)]
@@ -50,7 +50,8 @@ pub trait Embedded<const N: usize>: Default {
     fn begin<F: Rhs<N>>(&mut self, f: &F, t: f64, y: &[f64; N], f0: &mut [f64; N]);
 
     /// Attempt a step of `h` from (t, y): the new state into `y_new`, the error estimate into
-    /// `err`. Returns false if the attempt failed outright (e.g. Newton did not converge).
+    /// `err`. Returns false if the attempt failed outright (e.g. Newton did not converge) or
+    /// `y_new` is not finite (a method tests it with its own values, in one chain).
     #[allow(clippy::too_many_arguments)]
     fn attempt<F: Rhs<N>>(
         &mut self,
@@ -230,7 +231,7 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
     let mut f0 = [0.0; N];
     method.begin(f, t0, &z, &mut f0);
     stats.evaluations += 1;
-    if !all_finite(&f0) || !all_finite(&z) {
+    if !all_finite_in([&f0, &z]) {
         return Err(SolveError::NonFinite { t: t0 });
     }
     let mut h = if *h_next > 0.0 {
@@ -253,7 +254,7 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
         let last = h >= remaining;
         let hs = if last { remaining } else { h };
         let ok = method.attempt(f, t, &z, hs, &mut y_new, &mut err, ctl, &mut stats);
-        let e = if ok && all_finite(&y_new) {
+        let e = if ok {
             ctl.norm(F::CONTROLLED, &err, &z, &y_new)
         } else {
             f64::INFINITY

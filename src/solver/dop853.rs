@@ -3,7 +3,7 @@
 
 use super::adaptive::{Adaptive, Controls, Embedded};
 use super::fixed::{FixedStep, Formula};
-use super::{Rhs, SolveStats, all_finite};
+use super::{Rhs, SolveStats, all_finite_in};
 
 // The DOP853 tableau of Hairer, Norsett & Wanner (Solving ODEs I, II.10): 12 stages of
 // order 8, error estimators of orders 5 and 3. Generated from the published coefficients.
@@ -351,7 +351,7 @@ impl<const N: usize> Embedded<N> for Dop853Stages<N> {
         for i in 0..N {
             err[i] = e5[i] * factor;
         }
-        all_finite(&self.k[S])
+        all_finite_in([y_new, &self.k[S]])
     }
 
     fn accepted(&mut self) {

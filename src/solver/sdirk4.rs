@@ -7,7 +7,7 @@
 use nalgebra::{Const, DimMin, SMatrix, SVector};
 
 use super::adaptive::{Adaptive, Controls, Embedded};
-use super::{Rhs, SolveStats};
+use super::{Rhs, SolveStats, all_finite};
 
 const GAMMA: f64 = 0.25;
 const C: [f64; 5] = [0.25, 0.75, 11.0 / 20.0, 0.5, 1.0];
@@ -113,7 +113,7 @@ where
         for i in 0..N {
             err[i] = e[i];
         }
-        true
+        all_finite(y_new)
     }
 
     fn accepted(&mut self) {}
