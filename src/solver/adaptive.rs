@@ -79,6 +79,19 @@ const SAFETY: f64 = 0.9;
 const MIN_SHRINK: f64 = 0.2;
 const MAX_GROWTH: f64 = 5.0;
 
+/// f64::min(a, b) for an `a` that is not NaN (a step size), without f64::min's NaN test of `a`
+/// on every step: a NaN `b` still gives `a`.
+#[inline(always)]
+fn at_most(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
+}
+
+/// f64::max(a, b) for an `a` that is not NaN, as [`at_most`].
+#[inline(always)]
+fn at_least(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
+
 /// The smallest integer >= x >= 0, usable in constants.
 const fn ceil_u32(x: f64) -> u32 {
     let n = x as u32;
@@ -243,7 +256,7 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
     } else {
         initial_step(ctl, M::ORDER, f, t0, &z, &f0, span)
     };
-    h = h.min(ctl.max_step);
+    h = at_most(h, ctl.max_step);
     let mut t = t0;
     let (mut y_new, mut err) = ([0.0; N], [0.0; N]);
     let mut just_rejected = false;
@@ -273,11 +286,15 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
             };
             let fac = if just_rejected { fac.min(1.0) } else { fac };
             just_rejected = false;
-            let proposal = (hs * fac).min(ctl.max_step);
+            let proposal = at_most(hs * fac, ctl.max_step);
             z = y_new;
             if last {
                 // A step cut short to land on t1 says little about the natural step.
-                break if hs < h { h.max(proposal) } else { proposal };
+                break if hs < h {
+                    at_least(h, proposal)
+                } else {
+                    proposal
+                };
             }
             t += hs;
             h = proposal;
@@ -344,6 +361,18 @@ mod tests {
             ctl.norm(3, &[1.0; 3], &[0.5; 3], &[f64::NAN, 0.5, 0.5])
                 .is_nan()
         );
+    }
+
+    /// at_most and at_least against f64::min and max, bit for bit, for every `a` not NaN.
+    #[test]
+    fn at_most_and_at_least_are_min_and_max() {
+        let values = [0.0, 5e-324, 1e-3, 2.5, f64::MAX, f64::INFINITY, -1.0];
+        for a in values {
+            for b in values.into_iter().chain([f64::NAN]) {
+                assert_eq!(at_most(a, b).to_bits(), a.min(b).to_bits(), "{a} {b}");
+                assert_eq!(at_least(a, b).to_bits(), a.max(b).to_bits(), "{a} {b}");
+            }
+        }
     }
 
     #[test]
