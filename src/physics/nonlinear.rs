@@ -18,6 +18,9 @@ pub mod state {
     /// Dissipated energy, integral of c x'^2.
     pub const DISSIPATED: usize = 3;
     pub const DIM: usize = 4;
+    /// The components an integrator controls the error of, x and x'; the energies after them
+    /// are quadratures.
+    pub const CONTROLLED: usize = 2;
 }
 
 /// Eq 2.11 driven by a base acceleration given over the interval being integrated.
@@ -192,6 +195,8 @@ struct Fixed<'a, E, B> {
 }
 
 impl<E: Exponent, B: Input> Rhs<{ state::DIM }> for Fixed<'_, E, B> {
+    const CONTROLLED: usize = state::CONTROLLED;
+
     #[inline]
     fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
         let a_b = self.input.at(&self.model.base, t);
@@ -238,6 +243,8 @@ impl OscillatorSplit<{ state::DIM }> for NonlinearTld {
 }
 
 impl Rhs<{ state::DIM }> for NonlinearTld {
+    const CONTROLLED: usize = state::CONTROLLED;
+
     #[inline]
     fn eval(&self, t: f64, y: &[f64; state::DIM], dy: &mut [f64; state::DIM]) {
         self.eval_with(self.stiffness.power, self.base.at(t), y, dy);
@@ -303,6 +310,47 @@ mod tests {
         }
         // The local frequency at rest is omega_f.
         assert!((Rhs::stiffness(&m, 0.0, &[0.0; state::DIM]) - 5.6).abs() < 1e-12);
+    }
+
+    /// The energies are the quadratures past Rhs::CONTROLLED: nothing in f depends on them
+    /// (an integrator need not error-control them), for the model and for it compiled.
+    #[test]
+    fn the_energies_are_quadratures_nothing_depends_on() {
+        use crate::solver::Rhs;
+        fn ride_along<F: Rhs<{ state::DIM }>>(f: &F) {
+            assert_eq!(F::CONTROLLED, state::WORK_IN);
+            let y = [0.03, -0.2, 0.0, 0.0];
+            let mut other = y;
+            other[F::CONTROLLED..].fill(7.5e3);
+            let (mut a, mut b) = ([0.0; state::DIM], [0.0; state::DIM]);
+            f.eval(0.1, &y, &mut a);
+            f.eval(0.1, &other, &mut b);
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+        }
+        struct Check;
+        impl RhsJob for Check {
+            type Output = ();
+            fn run<F: CompiledTld>(self, f: &F) {
+                ride_along(f);
+            }
+        }
+        for base in [
+            BaseAcceleration::held(0.4),
+            BaseAcceleration {
+                t0: 0.0,
+                a: [0.4, 1.0, -2.0],
+            },
+        ] {
+            for eta in [3.0, 2.5] {
+                let m = NonlinearTld {
+                    stiffness: PowerLaw::new(5.6, 1.0, eta, 0.25),
+                    c: 0.3,
+                    base,
+                };
+                ride_along(&m);
+                m.with_exponent(Check);
+            }
+        }
     }
 
     #[test]

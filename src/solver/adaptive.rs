@@ -2,7 +2,7 @@
 //! its error estimate; this driver chooses step sizes, lands exactly on the interval's end,
 //! bounds the work and carries the step size to the next interval.
 
-use super::{Rhs, SolveError, SolveStats, all_finite};
+use super::{Rhs, SolveError, SolveStats, all_finite_in};
 
 /// Error tolerance and work bounds of an adaptive integrator.
 #[derive(Clone, Debug, PartialEq)]
@@ -20,12 +20,18 @@ pub struct Controls<const N: usize> {
 }
 
 impl<const N: usize> Controls<N> {
-    /// RMS of the controlled components of `e`, each over its tolerance at y0 and y1.
-    pub fn norm(&self, e: &[f64; N], y0: &[f64; N], y1: &[f64; N]) -> f64 {
+    /// RMS of the controlled components of `e`, each over its tolerance at y0 and y1, among
+    /// the first `leading` (a right-hand side's [`Rhs::CONTROLLED`]: the rest have abs_scale 0).
+    #[inline(always)]
+    pub fn norm(&self, leading: usize, e: &[f64; N], y0: &[f64; N], y1: &[f64; N]) -> f64 {
         let (mut sum, mut n) = (0.0, 0usize);
-        for i in 0..N {
+        for i in 0..leading.min(N) {
             if self.abs_scale[i] > 0.0 {
-                let sc = self.rtol * (self.abs_scale[i] + y0[i].abs().max(y1[i].abs()));
+                // The larger magnitude; a NaN in y1 (a failed step's state) gives NaN. Not
+                // f64::max, which would take y0's then: its NaN test costs five instructions
+                // per component on every step, and the driver rejects a non-finite y1 anyway.
+                let (a, b) = (y0[i].abs(), y1[i].abs());
+                let sc = self.rtol * (self.abs_scale[i] + if a > b { a } else { b });
                 sum += (e[i] / sc).powi(2);
                 n += 1;
             }
@@ -48,7 +54,8 @@ pub trait Embedded<const N: usize>: Default {
     fn begin<F: Rhs<N>>(&mut self, f: &F, t: f64, y: &[f64; N], f0: &mut [f64; N]);
 
     /// Attempt a step of `h` from (t, y): the new state into `y_new`, the error estimate into
-    /// `err`. Returns false if the attempt failed outright (e.g. Newton did not converge).
+    /// `err`. Returns false if the attempt failed outright (e.g. Newton did not converge) or
+    /// `y_new` is not finite (a method tests it with its own values, in one chain).
     #[allow(clippy::too_many_arguments)]
     fn attempt<F: Rhs<N>>(
         &mut self,
@@ -71,6 +78,19 @@ pub trait Embedded<const N: usize>: Default {
 const SAFETY: f64 = 0.9;
 const MIN_SHRINK: f64 = 0.2;
 const MAX_GROWTH: f64 = 5.0;
+
+/// f64::min(a, b) for an `a` that is not NaN (a step size), without f64::min's NaN test of `a`
+/// on every step: a NaN `b` still gives `a`.
+#[inline(always)]
+fn at_most(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
+}
+
+/// f64::max(a, b) for an `a` that is not NaN, as [`at_most`].
+#[inline(always)]
+fn at_least(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
 
 /// The smallest integer >= x >= 0, usable in constants.
 const fn ceil_u32(x: f64) -> u32 {
@@ -125,7 +145,23 @@ impl<const N: usize, M: Embedded<N>> Adaptive<N, M> {
 
     /// Advance `y` from `t0` to `t1` (> t0) to tolerance. On error `y` and the carried step
     /// size are left unchanged.
+    #[inline(never)]
     pub fn integrate<F: Rhs<N>>(
+        &mut self,
+        f: &F,
+        t0: f64,
+        t1: f64,
+        y: &mut [f64; N],
+    ) -> Result<SolveStats, SolveError> {
+        self.integrate_inlined(f, t0, t1, y)
+    }
+
+    /// [`Adaptive::integrate`] inlined into the caller, for a cheap explicit method: with the
+    /// caller's copy of the state and its checks in the same function, the stages and the
+    /// state stay in registers (an implicit method's linear algebra is better left where the
+    /// compiler puts it).
+    #[inline(always)]
+    pub fn integrate_inlined<F: Rhs<N>>(
         &mut self,
         f: &F,
         t0: f64,
@@ -155,8 +191,8 @@ fn initial_step<const N: usize, F: Rhs<N>>(
     span: f64,
 ) -> f64 {
     let zero = [0.0; N];
-    let d0 = ctl.norm(y, &zero, &zero);
-    let d1 = ctl.norm(f0, y, y);
+    let d0 = ctl.norm(F::CONTROLLED, y, &zero, &zero);
+    let d1 = ctl.norm(F::CONTROLLED, f0, y, y);
     // From rest the state says nothing of the time scale: let the second estimate decide.
     let h0 = if d0 < 1e-5 || d1 < 1e-5 {
         0.01 * span
@@ -173,7 +209,7 @@ fn initial_step<const N: usize, F: Rhs<N>>(
     for i in 0..N {
         df[i] = (f1[i] - f0[i]) / h0;
     }
-    let d2 = ctl.norm(&df, y, y);
+    let d2 = ctl.norm(F::CONTROLLED, &df, y, y);
     // Nothing moves: any step is exact, so take the whole interval.
     let h1 = if d1.max(d2) <= 1e-15 {
         span
@@ -201,6 +237,7 @@ fn proposal_below(order: f64, e: f64, hs: f64, h: f64) -> bool {
 
 /// Advance `y` from `t0` to `t1` (> t0) to tolerance with `method`, starting from the carried
 /// step `*h_next` (0: choose). On error `y` and `*h_next` are left unchanged.
+#[inline(always)]
 fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
     method: &mut M,
     ctl: &Controls<N>,
@@ -210,13 +247,19 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
     t1: f64,
     y: &mut [f64; N],
 ) -> Result<SolveStats, SolveError> {
+    debug_assert!(
+        ctl.abs_scale[F::CONTROLLED.min(N)..]
+            .iter()
+            .all(|&s| s == 0.0),
+        "components past Rhs::CONTROLLED are not error-controlled"
+    );
     let span = t1 - t0;
     let mut stats = SolveStats::default();
     let mut z = *y;
     let mut f0 = [0.0; N];
     method.begin(f, t0, &z, &mut f0);
     stats.evaluations += 1;
-    if !all_finite(&f0) || !all_finite(&z) {
+    if !all_finite_in([&f0, &z]) {
         return Err(SolveError::NonFinite { t: t0 });
     }
     let mut h = if *h_next > 0.0 {
@@ -224,7 +267,7 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
     } else {
         initial_step(ctl, M::ORDER, f, t0, &z, &f0, span)
     };
-    h = h.min(ctl.max_step);
+    h = at_most(h, ctl.max_step);
     let mut t = t0;
     let (mut y_new, mut err) = ([0.0; N], [0.0; N]);
     let mut just_rejected = false;
@@ -239,8 +282,8 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
         let last = h >= remaining;
         let hs = if last { remaining } else { h };
         let ok = method.attempt(f, t, &z, hs, &mut y_new, &mut err, ctl, &mut stats);
-        let e = if ok && all_finite(&y_new) {
-            ctl.norm(&err, &z, &y_new)
+        let e = if ok {
+            ctl.norm(F::CONTROLLED, &err, &z, &y_new)
         } else {
             f64::INFINITY
         };
@@ -260,10 +303,14 @@ fn integrate<const N: usize, M: Embedded<N>, F: Rhs<N>>(
             };
             let fac = if just_rejected { fac.min(1.0) } else { fac };
             just_rejected = false;
-            let proposal = (hs * fac).min(ctl.max_step);
+            let proposal = at_most(hs * fac, ctl.max_step);
             if last {
                 // A step cut short to land on t1 says little about the natural step.
-                break if hs < h { h.max(proposal) } else { proposal };
+                break if hs < h {
+                    at_least(h, proposal)
+                } else {
+                    proposal
+                };
             }
             t += hs;
             h = proposal;
@@ -296,6 +343,53 @@ mod tests {
     use crate::solver::dop853::Dop853Stages;
     use crate::solver::dopri5::DormandPrince;
     use crate::solver::sdirk4::Sdirk4Stages;
+
+    /// The norm against its formula with f64::max, bit for bit, over finite states of every
+    /// kind; a NaN in the new state gives NaN.
+    #[test]
+    fn the_norm_takes_the_larger_magnitude() {
+        let ctl = Controls {
+            rtol: 1e-7,
+            abs_scale: [0.125, 2.0, 0.0],
+            max_step: 1.0,
+            max_steps: 10,
+        };
+        let values = [0.0, -0.0, 5e-324, -3.5, 2.25, 1e300, -f64::MAX];
+        for &a in &values {
+            for &b in &values {
+                let (y0, y1, e) = ([a, b, 1.0], [b, -a, 7.0], [1e-9, -3e-8, 1.0]);
+                let want = ((0..2)
+                    .map(|i| {
+                        let sc = ctl.rtol * (ctl.abs_scale[i] + y0[i].abs().max(y1[i].abs()));
+                        (e[i] / sc).powi(2)
+                    })
+                    .fold(0.0, |s, t| s + t)
+                    / 2.0)
+                    .sqrt();
+                assert_eq!(
+                    ctl.norm(3, &e, &y0, &y1).to_bits(),
+                    want.to_bits(),
+                    "{a} {b}"
+                );
+            }
+        }
+        assert!(
+            ctl.norm(3, &[1.0; 3], &[0.5; 3], &[f64::NAN, 0.5, 0.5])
+                .is_nan()
+        );
+    }
+
+    /// at_most and at_least against f64::min and max, bit for bit, for every `a` not NaN.
+    #[test]
+    fn at_most_and_at_least_are_min_and_max() {
+        let values = [0.0, 5e-324, 1e-3, 2.5, f64::MAX, f64::INFINITY, -1.0];
+        for a in values {
+            for b in values.into_iter().chain([f64::NAN]) {
+                assert_eq!(at_most(a, b).to_bits(), a.min(b).to_bits(), "{a} {b}");
+                assert_eq!(at_least(a, b).to_bits(), a.max(b).to_bits(), "{a} {b}");
+            }
+        }
+    }
 
     #[test]
     fn the_full_growth_shortcut_agrees_with_the_formula() {

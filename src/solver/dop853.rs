@@ -3,7 +3,7 @@
 
 use super::adaptive::{Adaptive, Controls, Embedded};
 use super::fixed::{FixedStep, Formula};
-use super::{Rhs, SolveStats, all_finite};
+use super::{Rhs, SolveStats, all_finite_in};
 
 // The DOP853 tableau of Hairer, Norsett & Wanner (Solving ODEs I, II.10): 12 stages of
 // order 8, error estimators of orders 5 and 3. Generated from the published coefficients.
@@ -342,13 +342,16 @@ impl<const N: usize> Embedded<N> for Dop853Stages<N> {
                 e3[i] += h * E3[j] * k[i];
             }
         }
-        let (n5, n3) = (ctl.norm(&e5, y, y_new), ctl.norm(&e3, y, y_new));
+        let (n5, n3) = (
+            ctl.norm(F::CONTROLLED, &e5, y, y_new),
+            ctl.norm(F::CONTROLLED, &e3, y, y_new),
+        );
         let denom = (n5 * n5 + 0.01 * n3 * n3).sqrt();
         let factor = if denom > 0.0 { n5 / denom } else { 0.0 };
         for i in 0..N {
             err[i] = e5[i] * factor;
         }
-        all_finite(&self.k[S])
+        all_finite_in([y_new, &self.k[S]])
     }
 
     fn accepted(&mut self) {

@@ -3,7 +3,7 @@
 
 use super::adaptive::{Adaptive, Controls, Embedded};
 use super::fixed::{FixedStep, Formula};
-use super::{Rhs, SolveStats, all_finite};
+use super::{Rhs, SolveStats, all_finite_in};
 
 // Butcher tableau.
 const C2: f64 = 1.0 / 5.0;
@@ -117,11 +117,13 @@ impl<const N: usize> Default for DormandPrince<N> {
 impl<const N: usize> Embedded<N> for DormandPrince<N> {
     const ORDER: f64 = 5.0;
 
+    #[inline(always)]
     fn begin<F: Rhs<N>>(&mut self, f: &F, t: f64, y: &[f64; N], f0: &mut [f64; N]) {
         f.eval(t, y, &mut self.k1);
         *f0 = self.k1;
     }
 
+    #[inline(always)]
     fn attempt<F: Rhs<N>>(
         &mut self,
         f: &F,
@@ -143,9 +145,10 @@ impl<const N: usize> Embedded<N> for DormandPrince<N> {
             err[i] =
                 hs * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
         }
-        all_finite(k7)
+        all_finite_in([y_new, k7])
     }
 
+    #[inline(always)]
     fn accepted(&mut self) {
         self.k1 = self.k7;
     }

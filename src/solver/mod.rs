@@ -19,6 +19,11 @@ pub use sdirk4::{Sdirk4, Sdirk4Stages};
 
 /// y' = f(t, y) for a state of fixed size N.
 pub trait Rhs<const N: usize> {
+    /// How many leading components error control may measure. The components past them are
+    /// quadratures that ride along, never error-controlled (abs_scale 0): known at compile
+    /// time, the error norm neither tests nor forms them.
+    const CONTROLLED: usize = N;
+
     fn eval(&self, t: f64, y: &[f64; N], dy: &mut [f64; N]);
 
     /// Magnitude of the fastest local time scale |lambda|max at (t, y), in 1/s. The default is
@@ -123,7 +128,16 @@ pub struct SolveStats {
 #[inline(always)]
 #[allow(clippy::eq_op)] // v - v is the test: 0 or NaN
 pub(crate) fn all_finite<const N: usize>(y: &[f64; N]) -> bool {
-    y.iter().fold(0.0, |sum, v| sum + (v - v)) == 0.0
+    all_finite_in([y])
+}
+
+/// Whether every value of every array is finite: [`all_finite`] in one chain, one test.
+#[inline(always)]
+#[allow(clippy::eq_op)] // v - v is the test: 0 or NaN
+pub(crate) fn all_finite_in<const N: usize, const K: usize>(ys: [&[f64; N]; K]) -> bool {
+    ys.iter()
+        .fold(0.0, |sum, y| y.iter().fold(sum, |sum, v| sum + (v - v)))
+        == 0.0
 }
 
 #[cfg(test)]
@@ -149,6 +163,18 @@ mod tests {
             }
         }
         assert!(!all_finite(&[f64::INFINITY, f64::NEG_INFINITY]));
+        // several arrays: a non-finite value in any of them
+        let ok = [1.0, -0.0, f64::MAX];
+        assert!(all_finite_in([&ok, &ok, &ok]));
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for which in 0..3 {
+                for k in 0..3 {
+                    let mut ys = [ok; 3];
+                    ys[which][k] = bad;
+                    assert!(!all_finite_in([&ys[0], &ys[1], &ys[2]]), "{ys:?}");
+                }
+            }
+        }
     }
 
     /// x'' = -w^2 x: exact solution x = cos(w t), v = -w sin(w t).
@@ -502,6 +528,31 @@ mod tests {
                 .expect("fresh");
             assert_eq!(y_kept, y_fresh, "interval {k}");
         }
+    }
+
+    /// A quadrature that overflows while every slope stays finite: each error-controlled
+    /// method refuses the step (the state is not finite) and leaves the state alone.
+    #[test]
+    fn an_overflowing_quadrature_is_refused() {
+        struct Overflow;
+        impl Rhs<2> for Overflow {
+            const CONTROLLED: usize = 1;
+            fn eval(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+                dy[0] = -y[0];
+                dy[1] = f64::MAX;
+            }
+        }
+        fn check<M: Embedded<2>>() {
+            let mut m = Adaptive::<2, M>::new(1e-8, [1.0, 0.0], f64::INFINITY, 100);
+            // at the largest finite value: any step of more than 1e-16 overflows
+            let mut y = [1.0, f64::MAX];
+            let r = m.integrate(&Overflow, 0.0, 1.0, &mut y);
+            assert!(matches!(r, Err(SolveError::NonFinite { .. })), "{r:?}");
+            assert_eq!(y, [1.0, f64::MAX]);
+        }
+        check::<DormandPrince<2>>();
+        check::<Dop853Stages<2>>();
+        check::<Sdirk4Stages<2>>();
     }
 
     /// y' = y^2 blows up at t = 1: the integrator must stop with an error, not return garbage.

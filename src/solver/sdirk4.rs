@@ -7,7 +7,7 @@
 use nalgebra::{Const, DimMin, SMatrix, SVector};
 
 use super::adaptive::{Adaptive, Controls, Embedded};
-use super::{Rhs, SolveStats};
+use super::{Rhs, SolveStats, all_finite};
 
 const GAMMA: f64 = 0.25;
 const C: [f64; 5] = [0.25, 0.75, 11.0 / 20.0, 0.5, 1.0];
@@ -85,7 +85,7 @@ where
                     z[i] += dz[i];
                 }
                 // Converged well below the step tolerance.
-                if ctl.norm(&dz_arr, &z, &z) < 1e-3 {
+                if ctl.norm(F::CONTROLLED, &dz_arr, &z, &z) < 1e-3 {
                     converged = true;
                     break;
                 }
@@ -113,7 +113,7 @@ where
         for i in 0..N {
             err[i] = e[i];
         }
-        true
+        all_finite(y_new)
     }
 
     fn accepted(&mut self) {}
