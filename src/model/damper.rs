@@ -213,7 +213,7 @@ impl Damper {
                     std::ptr::read_volatile(input.v),
                 )
             };
-            tracker.update(h, a, v);
+            tracker.take_in(h, a, v);
         }
         // (The three, not the infinity after them: no store for it.)
         let [force, x, v, _] = &mut self.per_step;

@@ -8,6 +8,8 @@
 //! When the host never sets the base velocity, the velocity is rebuilt from the acceleration by
 //! a leaky integrator v' = a - w_c v, and its known gain w / sqrt(w^2 + w_c^2) is undone.
 
+use std::cell::Cell;
+
 /// Two cascaded first-order low-pass filters of each of `N` signals, sampled once per interval
 /// with the same gain: the same operations lane by lane, so that the signals' updates pack into
 /// one vector operation each (SSE2, NEON) with each lane's bits those of its own scalar update.
@@ -111,8 +113,14 @@ pub struct AmplitudeTracker {
     continuous: bool,
     /// The mean squares of the base velocity (lane `V`) and acceleration (lane `A`).
     squares: MeanSquare<2>,
-    /// The filters' response to a constant 1 (their normalisation).
-    weight: MeanSquare<1>,
+    /// The filters' response to a constant 1 (their normalisation), as of `pending` updates
+    /// ago: it does not depend on the input, so [`AmplitudeTracker::take_in`] counts its
+    /// updates and a read applies them ([`AmplitudeTracker::weight`]), the same operations.
+    /// In cells: a read (`&self`) applies them once, for every later read.
+    weight: Cell<MeanSquare<1>>,
+    /// Updates of `weight` counted, not applied (all with the current coefficients: a new
+    /// interval length applies them first).
+    pending: Cell<u64>,
     /// Derived from `h`, `tau` and `leak`: not part of what the tracker is.
     coefficients: Coefficients,
 }
@@ -133,7 +141,7 @@ impl PartialEq for AmplitudeTracker {
             other.prior_omega,
             other.rebuilt_v,
         ) && (self.measured_v_seen, self.continuous) == (other.measured_v_seen, other.continuous)
-            && (self.squares, self.weight) == (other.squares, other.weight)
+            && (self.squares, self.weight()) == (other.squares, other.weight())
     }
 }
 
@@ -151,7 +159,8 @@ impl AmplitudeTracker {
             measured_v_seen: false,
             continuous: false,
             squares: MeanSquare::default(),
-            weight: MeanSquare::default(),
+            weight: Cell::new(MeanSquare::default()),
+            pending: Cell::new(0),
             coefficients: Coefficients::NONE,
         }
     }
@@ -161,6 +170,21 @@ impl AmplitudeTracker {
     /// filters); what changes rarely is out of line.
     #[inline(always)]
     pub fn update(&mut self, h: f64, accel: f64, velocity: f64) {
+        self.advance::<false>(h, accel, velocity);
+    }
+
+    /// [`AmplitudeTracker::update`] with the weight's update counted, not applied: the same
+    /// bits once read, for the path where nothing reads the estimate every step (its filters'
+    /// part is a tenth of the update's cost, and a law that reads the estimate after every
+    /// update would apply it at once anyway, through the cell).
+    #[inline(always)]
+    pub fn take_in(&mut self, h: f64, accel: f64, velocity: f64) {
+        self.advance::<true>(h, accel, velocity);
+    }
+
+    /// The update; the weight's counted if `COUNT_WEIGHT`.
+    #[inline(always)]
+    fn advance<const COUNT_WEIGHT: bool>(&mut self, h: f64, accel: f64, velocity: f64) {
         // Both rare cases behind one branch, in integer bits: an interval length other than
         // the coefficients' (h > 0: equal bits are equal lengths; NaN, no coefficients yet,
         // equals none), or a base velocity other than +-0 (NaN included, as `!= 0.0` has it)
@@ -183,9 +207,37 @@ impl AmplitudeTracker {
             self.rebuilt_v
         };
         self.squares.update(alpha, [v * v, accel * accel]);
-        self.weight.update([alpha[0]], [1.0]);
+        if COUNT_WEIGHT {
+            *self.pending.get_mut() += 1;
+        } else {
+            let mut weight = self.weight();
+            weight.update([alpha[0]], [1.0]);
+            self.weight.set(weight);
+        }
         // Exact advance of v' = a - w_c v with a held.
         self.rebuilt_v = self.rebuilt_v * decay - accel * decay_m1 / self.leak;
+    }
+
+    /// The weight filters now: the counted updates applied (and kept applied), the same
+    /// operations in the same order, stopped where they no longer change it (a fixed point of
+    /// the recursion, reached within a few tens of time constants: every later update would
+    /// leave it too). A read after n counted steps costs at most that many updates, once.
+    fn weight(&self) -> MeanSquare<1> {
+        let mut weight = self.weight.get();
+        let pending = self.pending.get();
+        if pending > 0 {
+            self.pending.set(0);
+            let alpha = [self.coefficients.alpha[0]];
+            for _ in 0..pending {
+                let before = weight;
+                weight.update(alpha, [1.0]);
+                if weight == before {
+                    break;
+                }
+            }
+            self.weight.set(weight);
+        }
+        weight
     }
 
     /// What an update over an interval of length `h` with the base velocity `velocity` needs
@@ -195,6 +247,8 @@ impl AmplitudeTracker {
     #[inline(never)]
     fn settle(&mut self, h: f64, velocity: f64) {
         if self.coefficients.h != h {
+            // The counted updates were with the old coefficients.
+            self.weight();
             self.set_interval(h);
         }
         self.sees_velocity(velocity);
@@ -218,7 +272,8 @@ impl AmplitudeTracker {
     fn restart_measured(&mut self) {
         self.measured_v_seen = true;
         self.squares = MeanSquare::default();
-        self.weight = MeanSquare::default();
+        self.weight.set(MeanSquare::default());
+        self.pending.set(0);
     }
 
     /// Whether the host's base velocity `velocity` switches the estimator to it (it is not 0
@@ -277,7 +332,7 @@ impl AmplitudeTracker {
     pub fn continuous_rates(&self, accel: f64, velocity: f64) -> [f64; TRACKER_CONTINUOUS] {
         let v = self.velocity(velocity);
         let (first, second) = self.squares.rates(self.tau, [v * v, accel * accel]);
-        let ([w1], [w2]) = self.weight.rates(self.tau, [1.0]);
+        let ([w1], [w2]) = self.weight().rates(self.tau, [1.0]);
         [
             accel - self.leak * self.rebuilt_v,
             first[V],
@@ -324,8 +379,8 @@ impl AmplitudeTracker {
             self.squares.second[V],
             self.squares.first[A],
             self.squares.second[A],
-            self.weight.first[0],
-            self.weight.second[0],
+            self.weight().first[0],
+            self.weight().second[0],
         ]
     }
 
@@ -350,10 +405,11 @@ impl AmplitudeTracker {
             first: [s[2], s[4]],
             second: [s[3], s[5]],
         };
-        self.weight = MeanSquare {
+        self.pending.set(0);
+        self.weight = Cell::new(MeanSquare {
             first: [s[6]],
             second: [s[7]],
-        };
+        });
     }
 
     /// The current amplitude estimate [m]: Co-Simulation's of the filters (a mean square or
@@ -363,7 +419,7 @@ impl AmplitudeTracker {
         if self.continuous {
             return self.continuous_estimate().0;
         }
-        let w = self.weight.second[0].max(0.0);
+        let w = self.weight().second[0].max(0.0);
         if w <= 0.0 {
             return self.prior;
         }
@@ -420,7 +476,7 @@ impl AmplitudeTracker {
     /// is the prior, its gradient 0.
     pub fn continuous_estimate(&self) -> (f64, [f64; TRACKER_CONTINUOUS]) {
         let [v0, a0] = self.prior_means();
-        let w = self.weight.second[0] + PRIOR_WEIGHT;
+        let w = self.weight().second[0] + PRIOR_WEIGHT;
         let v = self.squares.second[V] + PRIOR_WEIGHT * v0;
         let a = self.squares.second[A] + PRIOR_WEIGHT * a0;
         let mut gradient = [0.0; TRACKER_CONTINUOUS];

@@ -228,3 +228,64 @@ fn the_continuous_estimates_gradient_is_its_change() {
         }
     }
 }
+
+/// The weight counted (`take_in`) is the weight updated (`update`), to the bit, whenever it is
+/// read: the estimate, the saved state and equality read at irregular times (one step, many
+/// steps, or none apart), over interval lengths that change (the counted updates applied with
+/// the old gain first), base.v first absent then driven (the count restarts), a restored state,
+/// and a run long enough for the weight to reach its fixed point (where the read stops
+/// applying), with a gain small enough that it takes tens of thousands of updates.
+#[test]
+fn the_counted_weight_is_the_updated_one_to_the_bit() {
+    let (tau, leak, prior, w) = (2.2, 0.28, 0.005, 5.9);
+    let mut eager = AmplitudeTracker::new(tau, leak, prior, w);
+    let mut lazy = eager.clone();
+    let (mut t, mut reads) = (0.0, 0);
+    for k in 0..150_000usize {
+        let h = match k {
+            0..30_000 => 1e-3,
+            30_000..30_500 => 2.5e-3,
+            _ => 1e-3,
+        };
+        let accel = -w * w * 0.003 * (w * t).sin();
+        let velocity = if (40_000..60_000).contains(&k) || k >= 80_000 {
+            w * 0.003 * (w * t).cos()
+        } else {
+            0.0
+        };
+        eager.update(h, accel, velocity);
+        lazy.take_in(h, accel, velocity);
+        if k == 70_000 {
+            let saved = eager.state();
+            eager.set_state(&saved).expect("a saved state");
+            lazy.set_state(&saved).expect("a saved state");
+        }
+        // Reads: every step for a while, then at growing gaps, and none over the 30,000 steps
+        // before the first change of interval length.
+        let read = (100..200).contains(&k) || (k > 30_000 && k.is_power_of_two()) || k % 7919 == 0;
+        if read {
+            reads += 1;
+            assert_eq!(
+                lazy.estimate().to_bits(),
+                eager.estimate().to_bits(),
+                "step {k}"
+            );
+            assert_eq!(
+                lazy.state().map(f64::to_bits),
+                eager.state().map(f64::to_bits),
+                "step {k}"
+            );
+            assert_eq!(lazy, eager, "step {k}");
+        }
+        t += h;
+    }
+    assert!(reads > 100, "{reads}");
+    assert_eq!(
+        lazy.state().map(f64::to_bits),
+        eager.state().map(f64::to_bits)
+    );
+    // The weight's filters have reached their fixed point (so the reads stopped early).
+    let before = eager.state();
+    eager.update(1e-3, 0.0, 0.01);
+    assert_eq!(eager.state()[6..].to_vec(), before[6..].to_vec());
+}
