@@ -174,9 +174,9 @@ impl AmplitudeTracker {
     }
 
     /// [`AmplitudeTracker::update`] with the weight's update counted, not applied: the same
-    /// bits once read, for the path where nothing reads the estimate every step (its filters'
-    /// part is a tenth of the update's cost, and a law that reads the estimate after every
-    /// update would apply it at once anyway, through the cell).
+    /// bits once read, for the path where nothing reads the estimate every step (there the
+    /// weight's update was about a third of the tracker's time per step; a law that reads the
+    /// estimate after every update would apply it at once anyway, through the cell).
     #[inline(always)]
     pub fn take_in(&mut self, h: f64, accel: f64, velocity: f64) {
         self.advance::<true>(h, accel, velocity);
@@ -247,8 +247,6 @@ impl AmplitudeTracker {
     #[inline(never)]
     fn settle(&mut self, h: f64, velocity: f64) {
         if self.coefficients.h != h {
-            // The counted updates were with the old coefficients.
-            self.weight();
             self.set_interval(h);
         }
         self.sees_velocity(velocity);
@@ -258,6 +256,8 @@ impl AmplitudeTracker {
     #[cold]
     #[inline(never)]
     fn set_interval(&mut self, h: f64) {
+        // The counted updates of the weight were with the old coefficients' gain.
+        self.weight();
         self.coefficients = Coefficients {
             h,
             alpha: [-(-h / self.tau).exp_m1(); 2],
