@@ -93,14 +93,15 @@ impl Values {
             // that base.a is one 8-byte load. Merged, the two are one 16-byte load over base.a's
             // 8-byte store in the fmi2SetReal just before, which the processor cannot forward:
             // the load then waits for the store to reach the cache, on the path from base.a
-            // to the step's first stage (RK4 one substep: 57.9 -> 54.3 ns per step).
+            // to the first evaluation (measured on Co-Simulation's step, RK4 one substep:
+            // 57.9 -> 54.3 ns per step; that step now reads base.a through `input_at`, and
+            // this serves Model Exchange's right-hand side and the output reads, which follow
+            // fmi2SetReal the same way).
             v: std::hint::black_box(self.0[BASE_V]),
             a_derivatives,
         }
     }
-}
 
-impl Values {
     /// Where base.a and base.v are, for [`crate::model::Damper::step_at`]: base.a is read
     /// alone before the step (one 8-byte load, which the processor forwards from
     /// fmi2SetReal's store just before), base.v only by an amplitude tracker.
