@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import shutil
 import statistics
 import tempfile
 from pathlib import Path
@@ -60,7 +61,11 @@ def main(argv=None):
             lines += [f"lib {lib.resolve()}", f"run c{k}_{r} fmu {' '.join(tokens[case])}"]
     job = tmp / "pairs.job"
     job.write_text("\n".join(lines) + "\n")
-    t = run(job)
+    try:
+        t = run(job)
+    finally:
+        # the runs' histories (hundreds of MB for long jobs): only the times are used
+        shutil.rmtree(tmp, ignore_errors=True)
     rounds = range(args.rounds)
     for i, lib in enumerate(libs):
         med = " ".join(f"{n}={statistics.median(t[f'{i}_{n}_{r}'] for r in rounds):.1f}"
