@@ -1,7 +1,9 @@
 """The careful C FMU of the Nonlinear model (bench/c/tld_c.c, issue #29): compiled with gcc -O2
 for the benchmark's native runs, which time it through the same host and calls as TLD.fmu, as
 it is and with the energies TLD.fmu also integrates (-DTLD_C_ENERGIES: energy.input and
-energy.dissipated, two more components of every stage), the same outputs as TLD.fmu's."""
+energy.dissipated, two more components of every stage), the same outputs as TLD.fmu's; and as it
+is with clang -O2, the LLVM back end rustc compiles TLD.fmu with (the same source through the
+other compiler: what of the difference to the gcc build is the back end's)."""
 from __future__ import annotations
 
 import subprocess
@@ -14,18 +16,20 @@ FLAGS = ["-O2", "-shared", "-fPIC"]
 _built: dict = {}
 
 
-#: The two builds: (implementation name in the report, extra gcc flags, library file name).
-BUILDS = [("C FMU", [], "tld_c.so"),
-          ("C FMU, energies", ["-DTLD_C_ENERGIES"], "tld_c_energies.so")]
+#: The builds: (implementation name in the report, compiler, extra flags, library file name,
+#: the prefix of its run ids).
+BUILDS = [("C FMU", "gcc", [], "tld_c.so", "c"),
+          ("C FMU, energies", "gcc", ["-DTLD_C_ENERGIES"], "tld_c_energies.so", "cE"),
+          ("C FMU, clang", "clang", [], "tld_c_clang.so", "cL")]
 
 
-def c_fmu(work: Path, energies: bool = False) -> Path:
-    """The C FMU's shared library under `work` (with the energies if `energies`), compiled once
-    per process."""
-    _, extra, name = BUILDS[int(energies)]
+def c_fmu(work: Path, build: int = 0) -> Path:
+    """The shared library of the C FMU's build `build` (an index into BUILDS) under `work`,
+    compiled once per process."""
+    _, cc, extra, name, _ = BUILDS[build]
     if name not in _built:
         out = work / name
-        subprocess.run(["gcc", *FLAGS, *extra, "-o", str(out), str(SOURCE), "-lm"], check=True)
+        subprocess.run([cc, *FLAGS, *extra, "-o", str(out), str(SOURCE), "-lm"], check=True)
         _built[name] = out
     return _built[name]
 

@@ -51,11 +51,14 @@ def observations(scenes, rows):
                  f"ns per doStep (median; range {min(diffs):.0f}–{max(diffs):.0f} ns), "
                  f"{np.median(ratios):.2f}× (range {min(ratios):.2f}–{max(ratios):.2f}×), on a "
                  f"plain loop of {min(loop):.0f}–{max(loop):.0f} ns per step: {verdict}.")
-    # the careful C FMU (bench/c/tld_c.c), as it is and with the energies TLD.fmu integrates:
+    # the careful C FMU (bench/c/tld_c.c), as it is, with the energies TLD.fmu integrates and
+    # through clang:
     # same method and substeps, and the fronts at equal error
     for impl, what in (("C FMU", "the C FMU"),
                        ("C FMU, energies", "the C FMU with the energies TLD.fmu integrates "
-                        "(`-DTLD_C_ENERGIES`, the same outputs)")):
+                        "(`-DTLD_C_ENERGIES`, the same outputs)"),
+                       ("C FMU, clang", "the C FMU compiled by clang -O2 (LLVM, rustc's back "
+                        "end)")):
         line = c_anchor(scenes, get, impl, what)
         if line:
             L.append(line)
@@ -289,7 +292,8 @@ def c_anchor(scenes, get, impl, what):
                     defaults.append(d[0]["ns_step"] / cc)
     if not same:
         return None
-    return (f"* **Against {what}** (`bench/c/tld_c.c`, gcc -O2, the same host and calls). Same "
+    cc = "clang -O2" if "clang" in impl else "gcc -O2"
+    return (f"* **Against {what}** (`bench/c/tld_c.c`, {cc}, the same host and calls). Same "
             f"method, same substeps (RK4 n = 1, the same error): TLD.fmu "
             f"{np.median(same):.2f}× its time per step (median over scenes and steps; range "
             f"{min(same):.2f}–{max(same):.2f}×)"

@@ -55,13 +55,12 @@ def run_native(fi: FmuInfo, sc: Scene, dt, a, refs, quick, tmp: Path):
     rid = f"rust_RK4abs_{ns}"
     meta[rid] = dict(impl="Rust diagnostic", method="RK4 over (t+dt)-t", setting=f"n={ns}")
     lines.append(f"run {rid} rk4 sub={ns} span=abs")
-    # the careful C FMU (bench/c/tld_c.c) through the same host and calls, as it is and with
-    # the energies TLD.fmu integrates: RK4 with the same substeps as TLD.fmu's,
+    # the careful C FMU (bench/c/tld_c.c) through the same host and calls, as it is, with the
+    # energies TLD.fmu integrates, and through clang: RK4 with the same substeps as TLD.fmu's,
     # DormandPrince45 at the same tolerances
     ctoks = c_tokens(fi, p)
-    for energies, (impl, _, _) in enumerate(BUILDS):
-        lines.append(f"lib {c_fmu(tmp, bool(energies))}")
-        tag = "cE" if energies else "c"
+    for build, (impl, _, _, _, tag) in enumerate(BUILDS):
+        lines.append(f"lib {c_fmu(tmp, build)}")
         for ns in substep_counts(dt, quick):
             rid = f"{tag}_RK4_{ns}"
             meta[rid] = dict(impl=impl, method="RK4", setting=f"n={ns}")
