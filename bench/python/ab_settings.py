@@ -23,8 +23,8 @@ from __future__ import annotations
 import argparse
 import datetime
 import math
-import statistics
 import shutil
+import statistics
 import subprocess
 import tempfile
 import xml.etree.ElementTree as ET

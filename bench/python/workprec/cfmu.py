@@ -12,7 +12,8 @@ from pathlib import Path
 from tld_fmu.paths import REPO
 
 SOURCE = REPO / "bench" / "c" / "tld_c.c"
-FLAGS = ["-O2", "-shared", "-fPIC"]
+OPT = "-O2"
+FLAGS = [OPT, "-shared", "-fPIC"]
 _built: dict = {}
 
 
@@ -21,6 +22,11 @@ _built: dict = {}
 BUILDS = [("C FMU", "gcc", [], "tld_c.so", "c"),
           ("C FMU, energies", "gcc", ["-DTLD_C_ENERGIES"], "tld_c_energies.so", "cE"),
           ("C FMU, clang", "clang", [], "tld_c_clang.so", "cL")]
+
+
+def compiled_by(impl: str) -> str:
+    """How the build named `impl` in the report is compiled, e.g. "gcc -O2"."""
+    return next(f"{cc} {OPT}" for name, cc, _, _, _ in BUILDS if name == impl)
 
 
 def c_fmu(work: Path, build: int = 0) -> Path:

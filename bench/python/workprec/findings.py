@@ -7,6 +7,7 @@ import numpy as np
 
 from tld_fmu.scenes import TOLS
 
+from .cfmu import compiled_by
 from .formats import dt_label, fmt_e, fmt_ns
 from .front import compare, cost_at, front
 
@@ -292,8 +293,8 @@ def c_anchor(scenes, get, impl, what):
                     defaults.append(d[0]["ns_step"] / cc)
     if not same:
         return None
-    cc = "clang -O2" if "clang" in impl else "gcc -O2"
-    return (f"* **Against {what}** (`bench/c/tld_c.c`, {cc}, the same host and calls). Same "
+    return (f"* **Against {what}** (`bench/c/tld_c.c`, {compiled_by(impl)}, the same host and "
+            f"calls). Same "
             f"method, same substeps (RK4 n = 1, the same error): TLD.fmu "
             f"{np.median(same):.2f}× its time per step (median over scenes and steps; range "
             f"{min(same):.2f}–{max(same):.2f}×)"
