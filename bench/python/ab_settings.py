@@ -14,10 +14,10 @@ library, or a git revision built as bench/python/ab.py does. --now: default the 
 release library (built first). The value references come from modelDescription/modelDescription.xml.
 The careful C FMU (bench/c/tld_c.c) runs in the same rounds as the "now" build: RK4 with one
 substep (the same arithmetic and error as TLD.fmu's) and DormandPrince45 at the same tolerances
-(not the same error: BENCHMARKS.md compares the fronts at equal error), in the benchmark's three
-builds (workprec/cfmu.py): gcc -O2 as it is, with -DTLD_C_ENERGIES, where it also integrates
-energy.input and energy.dissipated as TLD.fmu must (two more components of each stage), and
-clang -O2 (LLVM, rustc's back end).
+(not the same error: BENCHMARKS.md compares the fronts at equal error), in each of the
+benchmark's builds (workprec/cfmu.py): gcc -O2 as it is, with -DTLD_C_ENERGIES, where it also
+integrates energy.input and energy.dissipated as TLD.fmu must (two more components of each
+stage), clang -O2 (LLVM, rustc's back end), and its Rust port (bench/port) both ways.
 """
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ab import build, run
-from workprec.cfmu import BUILDS, c_fmu
+from workprec.cfmu import BUILDS, c_fmu, compiled_by
 from tld_fmu.machine import git_info, machine_line
 from tld_fmu.paths import REPO
 from tld_fmu.scenes import NATIVE_BIN
@@ -136,7 +136,8 @@ def main(argv=None):
     tmp = Path(tempfile.mkdtemp(prefix="tld_ab_settings_"))
     (tmp / "base").mkdir()
     (tmp / "now").mkdir()
-    # the C FMU's builds, their cases prefixed "" (as it is), "E" (energies) or "L" (clang)
+    # the C FMU's builds, their cases prefixed by their tags less the "c": "" (as it is), "E"
+    # (energies), "L" (clang), "R" and "RE" (the Rust port)
     c_libs = [(tag[1:], c_fmu(tmp, k)) for k, (_, _, _, _, tag) in enumerate(BUILDS)]
     # the C FMU runs in the "now" job: timed in the same rounds
     jobs = {"base": job(d, base, tmp / "base", args.steps),
@@ -173,15 +174,15 @@ def main(argv=None):
              ("defaults_Fixed", "C_DP45_1e-10", "DormandPrince45 at 1e-10 (TLD.fmu's default)"),
              ("defaults", "C_DP45_1e-10", "TLD.fmu's defaults (Tracked) against the C FMU's DP45 at 1e-10"),
              ("tight_Fixed", "C_DP45_1e-12", "DormandPrince45 at 1e-12")]
-    lines += ["", "The careful C FMU (bench/c/tld_c.c) in the same rounds: gcc -O2 as it is, with "
-              "the energies TLD.fmu integrates (-DTLD_C_ENERGIES), and clang -O2:", "",
-              "| case | TLD.fmu now ns/step | C FMU ns/step | TLD.fmu / C | C FMU with energies "
-              "ns/step | TLD.fmu / C with energies | C FMU, clang ns/step | TLD.fmu / C, clang |",
-              "|---|---|---|---|---|---|---|---|"]
+    lines += ["", "The careful C FMU (bench/c/tld_c.c) in the same rounds, each of the benchmark's "
+              "builds (bench/python/workprec/cfmu.py: " + "; ".join(
+                  f"{name}: {compiled_by(name)}" for name, *_ in BUILDS) + "):", "",
+              "| case | TLD.fmu now ns/step | " + " | ".join(
+                  f"{name} ns/step | TLD.fmu / it" for name, *_ in BUILDS) + " |",
+              "|---|---|" + "---|---|" * len(BUILDS)]
     for a, b, what in pairs:
-        lines.append(f"| {what} | {c[a]:.1f} | {c[b]:.1f} | {c[a] / c[b]:.2f} | "
-                     f"{c['E' + b]:.1f} | {c[a] / c['E' + b]:.2f} | "
-                     f"{c['L' + b]:.1f} | {c[a] / c['L' + b]:.2f} |")
+        lines.append(f"| {what} | {c[a]:.1f} | " + " | ".join(
+            f"{c[p + b]:.1f} | {c[a] / c[p + b]:.2f}" for p, _ in c_libs) + " |")
     lines.append("")
     for k in jobs:
         for n in ("defaults", "RK4_n1", "tight"):

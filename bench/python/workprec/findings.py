@@ -7,7 +7,7 @@ import numpy as np
 
 from tld_fmu.scenes import TOLS
 
-from .cfmu import compiled_by
+from .cfmu import compiled_by, source_of
 from .formats import dt_label, fmt_e, fmt_ns
 from .front import compare, cost_at, front
 
@@ -52,17 +52,24 @@ def observations(scenes, rows):
                  f"ns per doStep (median; range {min(diffs):.0f}–{max(diffs):.0f} ns), "
                  f"{np.median(ratios):.2f}× (range {min(ratios):.2f}–{max(ratios):.2f}×), on a "
                  f"plain loop of {min(loop):.0f}–{max(loop):.0f} ns per step: {verdict}.")
-    # the careful C FMU (bench/c/tld_c.c), as it is, with the energies TLD.fmu integrates and
-    # through clang:
+    # the careful C FMU (bench/c/tld_c.c), as it is, with the energies TLD.fmu integrates,
+    # through clang, and its Rust port (bench/port) both ways:
     # same method and substeps, and the fronts at equal error
     for impl, what in (("C FMU", "the C FMU"),
                        ("C FMU, energies", "the C FMU with the energies TLD.fmu integrates "
                         "(`-DTLD_C_ENERGIES`, the same outputs)"),
                        ("C FMU, clang", "the C FMU compiled by clang -O2 (LLVM, rustc's back "
-                        "end)")):
+                        "end)"),
+                       ("C FMU, Rust port", "the C FMU's Rust port (the C's program statement "
+                        "by statement, the same bits)"),
+                       ("C FMU, Rust port, energies", "the C FMU's Rust port with the "
+                        "energies")):
         line = c_anchor(scenes, get, impl, what)
         if line:
             L.append(line)
+    line = back_end(scenes, get)
+    if line:
+        L.append(line)
     # error floor from the interval length
     floor = []
     for sc in scenes:
@@ -293,7 +300,7 @@ def c_anchor(scenes, get, impl, what):
                     defaults.append(d[0]["ns_step"] / cc)
     if not same:
         return None
-    return (f"* **Against {what}** (`bench/c/tld_c.c`, {compiled_by(impl)}, the same host and "
+    return (f"* **Against {what}** (`{source_of(impl)}`, {compiled_by(impl)}, the same host and "
             f"calls). Same "
             f"method, same substeps (RK4 n = 1, the same error): TLD.fmu "
             f"{np.median(same):.2f}× its time per step (median over scenes and steps; range "
@@ -306,3 +313,30 @@ def c_anchor(scenes, get, impl, what):
                + "; ".join(f"{s}, {dt_label(dt)}: {lo:.2f}–{hi:.2f}×"
                            for s, dt, lo, hi in fronts) if fronts else "")
             + ". Where the time goes: docs/ARCHITECTURE.md, *Costs that shaped the code*.")
+
+
+def back_end(scenes, get):
+    """The findings' line on what rustc makes of the C FMU's own program: the Rust port's time
+    per step against the gcc and clang builds of the C at RK4 n = 1 (the same program, the same
+    bits), with and without the energies; None without their rows."""
+    pairs = (("C FMU, Rust port", "C FMU", "the gcc build"),
+             ("C FMU, Rust port", "C FMU, clang", "the clang build"),
+             ("C FMU, Rust port, energies", "C FMU, energies", "the gcc build with the energies"))
+    parts = []
+    for port, c, what in pairs:
+        ratios = []
+        for sc in scenes:
+            for dt in sc.dts:
+                a = get(sc.key, dt, port, "RK4", "n=1")
+                b = get(sc.key, dt, c, "RK4", "n=1")
+                if a and b:
+                    ratios.append(a[0]["ns_step"] / b[0]["ns_step"])
+        if ratios:
+            parts.append(f"{np.median(ratios):.2f}× {what} (range {min(ratios):.2f}–"
+                         f"{max(ratios):.2f}×)")
+    if not parts:
+        return None
+    return ("* **rustc's back end on the C FMU's own program** (bench/port against "
+            "bench/c/tld_c.c, the same statements and the same bits, RK4 n = 1, medians over "
+            "scenes and steps): the Rust port takes " + "; ".join(parts) + ". This part of "
+            "TLD.fmu's ratio to the C FMU is the compiler's, not TLD.fmu's code.")

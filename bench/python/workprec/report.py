@@ -79,12 +79,17 @@ def write_report(args, scenes, refs, rows, stderr_lines, timings, out_md: Path, 
         "values checked as set, steps all or nothing; RK4 with n equal substeps and "
         "Dormand–Prince 5(4) with the same error norm and carried step size as the plain-Rust "
         "baseline (its histories equal the baseline's bit for bit). Driven by the same "
-        "`tld-bench` loop as TLD.fmu, in the same job. Built three times: as it is (**C FMU**), "
+        "`tld-bench` loop as TLD.fmu, in the same job. Built five times: as it is (**C FMU**), "
         "with the energies TLD.fmu also integrates and outputs (**C FMU, energies**: "
         "`-DTLD_C_ENERGIES`, energy.input and energy.dissipated as two more components of "
         "every stage, not error-controlled), the like-for-like anchor for the same outputs, and "
         "as it is with clang -O2 (**C FMU, clang**: LLVM, the back end rustc compiles TLD.fmu "
-        "with; the same source, so its difference to the gcc build is the compilers'). Its "
+        "with; the same source, so its difference to the gcc build is the compilers'), and "
+        "ported to Rust (**C FMU, Rust port**, `bench/port`: the C's program statement by "
+        "statement, its histories equal to the C build's bit for bit, tests/python/"
+        "test_c_port.py; built by cargo with TLD.fmu's release profile), as it is and with the "
+        "energies (**C FMU, Rust port, energies**): what rustc's back end makes of the same "
+        "program. Its "
         "DormandPrince45 takes libm `pow` for the step factor on every accepted step, as "
         "Hairer's DOPRI5 does; TLD.fmu skips it where the factor is surely capped.")
     L.append(
@@ -203,6 +208,7 @@ def write_report(args, scenes, refs, rows, stderr_lines, timings, out_md: Path, 
             L.append("|---|---|---|---|---|---|---|---|")
             rs = [r for r in rows if r["scene"] == sc.key and r["dt"] == dt]
             order = {"TLD.fmu": 0, "C FMU": 1, "C FMU, energies": 1.5, "C FMU, clang": 1.7,
+                     "C FMU, Rust port": 1.8, "C FMU, Rust port, energies": 1.9,
                      "Rust baseline": 2,
                      "scipy solve_ivp": 3, "pythonfmu": 4, "TLD.fmu via fmpy": 5}
             for r in sorted(rs, key=lambda r: (order.get(r["impl"], 9), r["method"])):
