@@ -8,16 +8,17 @@ load, medians reported.
 The scene of issue #29: the Nonlinear model, eta = 2, phi = 1, damping = Constant (zeta = 0.02),
 base.a = -w^2 A sin(w t) held over each 1 ms step, w = 1.05 omega_f, A = 3 mm, from rest. Cases:
 the defaults (amplitude = Tracked, DormandPrince45 at 1e-10), the same with amplitude = Fixed,
-RK4 with one substep (Tracked and Fixed), DormandPrince45 at 1e-12 (tight, Tracked and Fixed),
-and the defaults with damping = NSD (where the tracker is read every step). --base: a built
-library, or a git revision built as bench/python/ab.py does. --now: default the working tree's
-release library (built first). The value references come from modelDescription/modelDescription.xml.
-The careful C FMU (bench/c/tld_c.c) runs in the same rounds as the "now" build: RK4 with one
-substep (the same arithmetic and error as TLD.fmu's) and DormandPrince45 at the same tolerances
-(not the same error: BENCHMARKS.md compares the fronts at equal error), in each of the
-benchmark's builds (workprec/cfmu.py): gcc -O2 as it is, with -DTLD_C_ENERGIES, where it also
-integrates energy.input and energy.dissipated as TLD.fmu must (two more components of each
-stage), clang -O2 (LLVM, rustc's back end), and its Rust port (bench/port) both ways.
+RK4 with one substep (Tracked and Fixed) and with two (Fixed), DormandPrince45 at 1e-12 (tight,
+Tracked and Fixed), and the defaults with damping = NSD (where the tracker is read every step).
+--base: a built library, or a git revision built as bench/python/ab.py does. --now: default the
+working tree's release library (built first). The value references come from
+modelDescription/modelDescription.xml. The careful C FMU (bench/c/tld_c.c) runs in the same rounds
+as the "now" build: RK4 with one and with two substeps (the same arithmetic and error as
+TLD.fmu's) and DormandPrince45 at the same tolerances (not the same error: BENCHMARKS.md compares
+the fronts at equal error), in each of the benchmark's builds (workprec/cfmu.py): gcc -O2 as it
+is, with -DTLD_C_ENERGIES, where it also integrates energy.input and energy.dissipated as TLD.fmu
+must (two more components of each stage), clang -O2 (LLVM, rustc's back end), and its Rust port
+(bench/port) both ways.
 """
 from __future__ import annotations
 
@@ -76,20 +77,24 @@ def cases(d: Description):
             d.token("zeta", 0.02)]
     fixed = [d.token("amplitude", "Fixed")]
     rk4 = [d.token("solver", "RK4"), d.token("solver.fixed_step", 1e-3)]
+    rk4_n2 = [d.token("solver", "RK4"), d.token("solver.fixed_step", 5e-4)]
     tight = [d.token("solver.tolerance", 1e-12)]
     nsd = [d.token("eta", 2.0), d.token("phi", 1.0)]
     return [("defaults", phys), ("defaults_Fixed", phys + fixed),
             ("RK4_n1", phys + rk4), ("RK4_n1_Fixed", phys + rk4 + fixed),
+            ("RK4_n2_Fixed", phys + rk4_n2 + fixed),
             ("tight", phys + tight), ("tight_Fixed", phys + tight + fixed),
             ("NSD_defaults", nsd)]
 
 
 def c_cases(d: Description):
     """[(name, tokens)]: the careful C FMU (bench/c/tld_c.c) on the same scene: RK4 with one
-    substep, DormandPrince45 at TLD.fmu's default tolerance and at the tight one."""
+    and with two substeps, DormandPrince45 at TLD.fmu's default tolerance and at the tight
+    one."""
     phys = [d.token("eta", 2.0), d.token("phi", 1.0), d.token("damping", "Constant"),
             d.token("zeta", 0.02)]
     return [("C_RK4_n1", phys + [d.token("solver", "RK4"), d.token("solver.fixed_step", 1e-3)]),
+            ("C_RK4_n2", phys + [d.token("solver", "RK4"), d.token("solver.fixed_step", 5e-4)]),
             ("C_DP45_1e-10", phys + [d.token("solver.tolerance", 1e-10)]),
             ("C_DP45_1e-12", phys + [d.token("solver.tolerance", 1e-12)])]
 
@@ -171,6 +176,7 @@ def main(argv=None):
         lines.append(f"| {n} | {b:.1f} | {w:.1f} | {w / b:.3f} | {'yes' if same[n] else 'NO'} |")
     c = med["now"]
     pairs = [("RK4_n1_Fixed", "C_RK4_n1", "RK4, one substep, the same error"),
+             ("RK4_n2_Fixed", "C_RK4_n2", "RK4, two substeps, the same error"),
              ("defaults_Fixed", "C_DP45_1e-10", "DormandPrince45 at 1e-10 (TLD.fmu's default)"),
              ("defaults", "C_DP45_1e-10", "TLD.fmu's defaults (Tracked) against the C FMU's DP45 at 1e-10"),
              ("tight_Fixed", "C_DP45_1e-12", "DormandPrince45 at 1e-12")]
