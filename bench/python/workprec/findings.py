@@ -278,15 +278,18 @@ def targets(scenes, rows):
 
 def c_anchor(scenes, get, impl, what):
     """The findings' line on TLD.fmu against the C FMU build `impl` (described as `what`): RK4
-    n = 1 against the same, the default settings against its DormandPrince45 front at their
-    error, and every setting against its front at equal error; None without its rows."""
-    same, fronts, defaults = [], [], []
+    with n = 1, 2, 4 and 8 substeps against the same, the default settings against its
+    DormandPrince45 front at their error, and every setting against its front at equal error;
+    None without its rows."""
+    fronts, defaults = [], []
+    same = {n: [] for n in (1, 2, 4, 8)}
     for sc in scenes:
         for dt in sc.dts:
-            a = get(sc.key, dt, "TLD.fmu", "RK4", "n=1")
-            c = get(sc.key, dt, impl, "RK4", "n=1")
-            if a and c:
-                same.append(a[0]["ns_step"] / c[0]["ns_step"])
+            for n, ratios in same.items():
+                a = get(sc.key, dt, "TLD.fmu", "RK4", f"n={n}")
+                c = get(sc.key, dt, impl, "RK4", f"n={n}")
+                if a and c:
+                    ratios.append(a[0]["ns_step"] / c[0]["ns_step"])
             pf = [(r["err"], r["ns_step"]) for r in get(sc.key, dt, "TLD.fmu") if not r["window"]]
             pc = [(r["err"], r["ns_step"]) for r in get(sc.key, dt, impl)]
             res, _, wr = compare(pf, pc, True, 1.0)
@@ -298,13 +301,16 @@ def c_anchor(scenes, get, impl, what):
                 where, cc = cost_at(front(pc), d[0]["err"])
                 if where == "in":
                     defaults.append(d[0]["ns_step"] / cc)
-    if not same:
+    one = same[1]
+    if not one:
         return None
+    more = ", ".join(f"n = {n}: {np.median(r):.2f}×" for n, r in same.items() if n > 1 and r)
     return (f"* **Against {what}** (`{source_of(impl)}`, {compiled_by(impl)}, the same host and "
             f"calls). Same "
             f"method, same substeps (RK4 n = 1, the same error): TLD.fmu "
-            f"{np.median(same):.2f}× its time per step (median over scenes and steps; range "
-            f"{min(same):.2f}–{max(same):.2f}×)"
+            f"{np.median(one):.2f}× its time per step (median over scenes and steps; range "
+            f"{min(one):.2f}–{max(one):.2f}×"
+            + (f"; with more substeps, medians {more}" if more else "") + ")"
             + (f"; default settings against its DormandPrince45 front at the same error: "
                f"{np.median(defaults):.2f}× (median; range {min(defaults):.2f}–"
                f"{max(defaults):.2f}×)" if defaults else "")
