@@ -24,36 +24,6 @@ pub struct FixedStep<M> {
     /// Most internal steps per interval.
     pub max_steps: u64,
     formula: PhantomData<M>,
-    substeps: Substeps,
-}
-
-/// The step count and size of the last interval cut into several steps, and what they were
-/// formed from. Communication steps are usually all alike, and forming n and h takes two
-/// divisions and three integer-float conversions in a row, which the first stage waits for
-/// (about 15 ns a doStep with two or more substeps). Derived, so not part of the state: equal
-/// whatever it holds, and rebuilt by the first interval that does not match it.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Substeps {
-    /// (span, max_step, max_steps) of the interval; NaN, the empty key, matches nothing.
-    key: (f64, f64, u64),
-    n: i64,
-    h: f64,
-}
-
-impl Default for Substeps {
-    fn default() -> Self {
-        Substeps {
-            key: (f64::NAN, f64::NAN, 0),
-            n: 1,
-            h: f64::NAN,
-        }
-    }
-}
-
-impl PartialEq for Substeps {
-    fn eq(&self, _other: &Self) -> bool {
-        true
-    }
 }
 
 /// Classical fourth-order Runge-Kutta with a fixed internal step.
@@ -65,13 +35,12 @@ impl<M: Formula> FixedStep<M> {
             max_step,
             max_steps,
             formula: PhantomData,
-            substeps: Substeps::default(),
         }
     }
 
     /// Advance `y` from `t0` to `t1`. On error `y` is left unchanged.
     pub fn integrate<const N: usize, F: Rhs<N>>(
-        &mut self,
+        &self,
         f: &F,
         t0: f64,
         t1: f64,
@@ -90,7 +59,6 @@ impl<M: Formula> FixedStep<M> {
             t1,
             self.max_step,
             self.max_steps,
-            &mut self.substeps,
             M::EVALS,
             y,
             &mut formula,
@@ -109,16 +77,13 @@ pub(super) trait OneStep<const N: usize> {
 }
 
 /// Advance `y` from `t0` to `t1` by `method`'s steps (`evals` evaluations each) in equal steps
-/// no longer than `max_step`, at most `max_steps` of them; `last` holds the count and size of
-/// the last interval of several steps. On error `y` is left unchanged.
+/// no longer than `max_step`, at most `max_steps` of them. On error `y` is left unchanged.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 pub(super) fn fixed_steps<const N: usize>(
     t0: f64,
     t1: f64,
     max_step: f64,
     max_steps: u64,
-    last: &mut Substeps,
     evals: u64,
     y: &mut [f64; N],
     method: &mut impl OneStep<N>,
@@ -140,14 +105,19 @@ pub(super) fn fixed_steps<const N: usize>(
             evaluations: evals,
         });
     }
-    let key = (span, max_step, max_steps);
-    if last.key != key {
-        *last = substeps(span, max_step, max_steps).ok_or(SolveError::TooManySteps {
+    // n = ceil(q) steps, and ceil(q) <= max_steps exactly when q <= max_steps; formed
+    // without libm's ceil (a call on baseline x86-64), counted in i64 (one instruction
+    // to f64, where u64 takes several).
+    let q = span / max_step * (1.0 - 1e-12);
+    if q.is_nan() || q > max_steps as f64 {
+        return Err(SolveError::TooManySteps {
             limit: max_steps,
             t: t0,
-        })?;
+        });
     }
-    let (n, h) = (last.n, last.h);
+    let whole = q as i64;
+    let n = if (whole as f64) < q { whole + 1 } else { whole }.max(1);
+    let h = span / n as f64;
     method.prepare(h);
     let mut z = *y;
     for i in 0..n {
@@ -163,27 +133,6 @@ pub(super) fn fixed_steps<const N: usize>(
         accepted: n,
         rejected: 0,
         evaluations: evals * n,
-    })
-}
-
-/// The count and size of the equal steps no longer than `max_step` that make up `span`, or None
-/// for more than `max_steps` of them (or a NaN).
-#[cold]
-#[inline(never)]
-fn substeps(span: f64, max_step: f64, max_steps: u64) -> Option<Substeps> {
-    // n = ceil(q) steps, and ceil(q) <= max_steps exactly when q <= max_steps; formed
-    // without libm's ceil (a call on baseline x86-64), counted in i64 (one instruction
-    // to f64, where u64 takes several).
-    let q = span / max_step * (1.0 - 1e-12);
-    if q.is_nan() || q > max_steps as f64 {
-        return None;
-    }
-    let whole = q as i64;
-    let n = if (whole as f64) < q { whole + 1 } else { whole }.max(1);
-    Some(Substeps {
-        key: (span, max_step, max_steps),
-        n,
-        h: span / n as f64,
     })
 }
 
@@ -208,64 +157,5 @@ impl Formula for Classical {
         let k4 = eval(t + h, &std::array::from_fn(|j| z[j] + h * k3[j]));
         let sixth = h / 6.0;
         std::array::from_fn(|j| z[j] + sixth * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A damped oscillator driven in time, so that a wrong stage time or step size shows.
-    struct Driven;
-
-    impl Rhs<2> for Driven {
-        fn eval(&self, t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
-            dy[0] = y[1];
-            dy[1] = -30.0 * y[0] - 0.3 * y[1] + (7.0 * t).sin();
-        }
-    }
-
-    /// The remembered step count and size change nothing: one integrator carried through
-    /// intervals of changing length, maximum step and maximum count agrees bit for bit, in its
-    /// state, statistics and refusals, with a fresh integrator for every interval.
-    #[test]
-    fn remembered_substeps_give_what_fresh_ones_give() {
-        let mut carried = Rk4::new(0.003, 10);
-        let (mut a, mut b) = ([0.1, 0.0], [0.1, 0.0]);
-        let mut t = 0.0;
-        // (span, max_step, max_steps): repeated spans (the remembered count used), a span
-        // that fits one step, new spans, a new max_step, and a smaller max_steps that refuses
-        // a span remembered as allowed
-        let plan = [
-            (0.01, 0.003, 10),
-            (0.01, 0.003, 10),
-            (0.01, 0.003, 10),
-            (0.002, 0.003, 10),
-            (0.01, 0.003, 10),
-            (0.013, 0.003, 10),
-            (0.01, 0.003, 10),
-            (0.01, 0.0045, 10),
-            (0.01, 0.0045, 10),
-            (0.01, 0.003, 10),
-            (0.01, 0.003, 3),
-            (0.009, 0.003, 3),
-        ];
-        let mut refused = 0;
-        for (span, max_step, max_steps) in plan {
-            carried.max_step = max_step;
-            carried.max_steps = max_steps;
-            let got = carried.integrate(&Driven, t, t + span, &mut a);
-            let want = Rk4::new(max_step, max_steps).integrate(&Driven, t, t + span, &mut b);
-            assert_eq!(
-                got, want,
-                "span {span}, max_step {max_step}, max_steps {max_steps}"
-            );
-            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "span {span}");
-            refused += usize::from(got.is_err());
-            t += span;
-        }
-        // 0.01 / 0.003 takes 4 steps: refused under max_steps 3; 0.009 takes 3
-        assert_eq!(refused, 1);
-        assert!(a[0] != 0.1);
     }
 }

@@ -10,7 +10,7 @@
 //!   y1 = E2 y + h/6 (E2 k1 + 2 E (k2 + k3) + k4).
 //! (Hochbruck & Ostermann, Exponential integrators, Acta Numerica 2010, section 2.3.)
 
-use super::fixed::{OneStep, Substeps, fixed_steps};
+use super::fixed::{OneStep, fixed_steps};
 use super::{OscillatorSplit, SolveError, SolveStats};
 
 /// The flows of the linear part over h/2 and h for one (h, w2, c), and their second columns
@@ -83,7 +83,6 @@ pub struct ExpRk4 {
     /// The flows of the last step size: communication steps are usually all alike, and the
     /// exponential and trigonometric functions would otherwise dominate a step's cost.
     flows: FlowCache,
-    substeps: Substeps,
 }
 
 impl ExpRk4 {
@@ -92,7 +91,6 @@ impl ExpRk4 {
             max_step,
             max_steps,
             flows: FlowCache::default(),
-            substeps: Substeps::default(),
         }
     }
 
@@ -129,17 +127,7 @@ impl ExpRk4 {
             f,
             cache: &mut self.flows.0,
         };
-        let (max_step, max_steps) = (self.max_step, self.max_steps);
-        fixed_steps(
-            t0,
-            t1,
-            max_step,
-            max_steps,
-            &mut self.substeps,
-            4,
-            y,
-            &mut lawson,
-        )
+        fixed_steps(t0, t1, self.max_step, self.max_steps, 4, y, &mut lawson)
     }
 }
 
