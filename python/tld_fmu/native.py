@@ -12,10 +12,12 @@ same order as tld_fmu.building.simulate, and returns each floor's peak |X| over 
 """
 from __future__ import annotations
 
+import errno
 import json
 import math
 import subprocess
 import tempfile
+import time
 from pathlib import Path
 
 from . import building
@@ -54,6 +56,24 @@ def request(name: str, cfg: dict, contract: Contract, inactive: list[float], w: 
             "timing": bool(timing)}
 
 
+def start(args: list[str], attempts: int = 12, **popen) -> subprocess.Popen:
+    """subprocess.Popen(args, **popen), tried again while the executable is "busy" (ETXTBSY).
+
+    A binary just written (study.py writes the master next to the unpacked FMU) cannot be
+    executed while any process holds it open for writing, and a process that another thread
+    forks at the moment of the write holds the writer's descriptor until it executes its own
+    program: a window of microseconds that a worker with two threads starting masters at once
+    hits now and then. Waits 2, 4, 8, ... ms between attempts (about 4 s in all)."""
+    for k in range(attempts - 1):
+        try:
+            return subprocess.Popen(args, **popen)
+        except OSError as e:
+            if e.errno != errno.ETXTBSY:
+                raise
+            time.sleep(0.002 * 2 ** k)
+    return subprocess.Popen(args, **popen)
+
+
 class MasterError(RuntimeError):
     """The master process failed as a whole (not one run)."""
 
@@ -65,8 +85,8 @@ class Master:
         self.binary = str(binary)
         # stderr to a file: a pipe nobody reads could fill and stall the master
         self.err = tempfile.TemporaryFile(mode="w+")
-        self.proc = subprocess.Popen([self.binary], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                     stderr=self.err, text=True, bufsize=1)
+        self.proc = start([self.binary], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                          stderr=self.err, text=True, bufsize=1)
         contract = Contract(md)
         ident = md.coSimulation.modelIdentifier
         library = Path(unzipdir) / "binaries" / "linux64" / f"{ident}.so"

@@ -151,3 +151,37 @@ def test_the_example_study_files_are_valid(fmu_path):
     c = Contract(fmu_path)
     for name in ("study.toml", "design.toml"):
         sweep.load_study(REPO / "scripts" / "examples" / name, c)
+
+
+def test_a_master_binary_busy_for_a_moment_is_started_on_a_later_attempt(monkeypatch):
+    """study.py writes the compiled master next to the unpacked FMU; a process another worker
+    thread forks during that write keeps the file "busy" (ETXTBSY) for a moment (a CI run's sweep
+    lost a run to it). native.start tries again for that error only, and not for ever."""
+    import errno
+    import subprocess
+
+    monkeypatch.setattr(native.time, "sleep", lambda s: None)
+    calls = []
+
+    def popen(args, **kw):
+        calls.append(args)
+        if len(calls) <= busy:
+            raise OSError(errno.ETXTBSY, "Text file busy")
+        if other:
+            raise OSError(errno.ENOENT, "No such file")
+        return "started"
+
+    monkeypatch.setattr(subprocess, "Popen", popen)
+    busy, other = 3, False
+    assert native.start(["tld-study"], stdin=None) == "started"
+    assert len(calls) == 4
+    calls.clear()
+    busy = 100   # busy on every attempt: the error reaches the caller after them all
+    with pytest.raises(OSError) as e:
+        native.start(["tld-study"], attempts=5)
+    assert e.value.errno == errno.ETXTBSY and len(calls) == 5
+    calls.clear()
+    busy, other = 0, True   # any other error at once
+    with pytest.raises(OSError) as e:
+        native.start(["tld-study"])
+    assert e.value.errno == errno.ENOENT and len(calls) == 1
