@@ -32,17 +32,21 @@ BUILDS = [("C FMU", "gcc", [], "tld_c.so", "c"),
            "tld_c_port_energies.so", "cRE")]
 
 
+def _compiler(impl: str) -> str:
+    """The compiler of the build named `impl` in the report (BUILDS' second field)."""
+    return next(cc for name, cc, _, _, _ in BUILDS if name == impl)
+
+
 def compiled_by(impl: str) -> str:
     """How the build named `impl` in the report is compiled, e.g. "gcc -O2"."""
-    cc = next(cc for name, cc, _, _, _ in BUILDS if name == impl)
+    cc = _compiler(impl)
     return ("rustc, the workspace's release profile (opt-level 3, fat LTO, TLD.fmu's own)"
             if cc == "cargo" else f"{cc} {OPT}")
 
 
 def source_of(impl: str) -> str:
     """The source file of the build named `impl`, as the report names it."""
-    cc = next(cc for name, cc, _, _, _ in BUILDS if name == impl)
-    return "bench/port" if cc == "cargo" else "bench/c/tld_c.c"
+    return "bench/port" if _compiler(impl) == "cargo" else "bench/c/tld_c.c"
 
 
 def c_fmu(work: Path, build: int = 0) -> Path:

@@ -276,20 +276,28 @@ def targets(scenes, rows):
     return dict(lines=lines, summary=summary)
 
 
+def rk4_ratios(scenes, get, impl, other, n):
+    """The time per step of `impl` over `other`'s, both RK4 with n substeps (the same error), for
+    every scene and step that has both."""
+    ratios = []
+    for sc in scenes:
+        for dt in sc.dts:
+            a = get(sc.key, dt, impl, "RK4", f"n={n}")
+            b = get(sc.key, dt, other, "RK4", f"n={n}")
+            if a and b:
+                ratios.append(a[0]["ns_step"] / b[0]["ns_step"])
+    return ratios
+
+
 def c_anchor(scenes, get, impl, what):
     """The findings' line on TLD.fmu against the C FMU build `impl` (described as `what`): RK4
     with n = 1, 2, 4 and 8 substeps against the same, the default settings against its
     DormandPrince45 front at their error, and every setting against its front at equal error;
     None without its rows."""
     fronts, defaults = [], []
-    same = {n: [] for n in (1, 2, 4, 8)}
+    same = {n: rk4_ratios(scenes, get, "TLD.fmu", impl, n) for n in (1, 2, 4, 8)}
     for sc in scenes:
         for dt in sc.dts:
-            for n, ratios in same.items():
-                a = get(sc.key, dt, "TLD.fmu", "RK4", f"n={n}")
-                c = get(sc.key, dt, impl, "RK4", f"n={n}")
-                if a and c:
-                    ratios.append(a[0]["ns_step"] / c[0]["ns_step"])
             pf = [(r["err"], r["ns_step"]) for r in get(sc.key, dt, "TLD.fmu") if not r["window"]]
             pc = [(r["err"], r["ns_step"]) for r in get(sc.key, dt, impl)]
             res, _, wr = compare(pf, pc, True, 1.0)
@@ -330,13 +338,7 @@ def back_end(scenes, get):
              ("C FMU, Rust port, energies", "C FMU, energies", "the gcc build with the energies"))
     parts = []
     for port, c, what in pairs:
-        ratios = []
-        for sc in scenes:
-            for dt in sc.dts:
-                a = get(sc.key, dt, port, "RK4", "n=1")
-                b = get(sc.key, dt, c, "RK4", "n=1")
-                if a and b:
-                    ratios.append(a[0]["ns_step"] / b[0]["ns_step"])
+        ratios = rk4_ratios(scenes, get, port, c, 1)
         if ratios:
             parts.append(f"{np.median(ratios):.2f}× {what} (range {min(ratios):.2f}–"
                          f"{max(ratios):.2f}×)")
