@@ -10,7 +10,7 @@
 //!   y1 = E2 y + h/6 (E2 k1 + 2 E (k2 + k3) + k4).
 //! (Hochbruck & Ostermann, Exponential integrators, Acta Numerica 2010, section 2.3.)
 
-use super::fixed::{OneStep, fixed_steps};
+use super::fixed::{OneStep, StepBound, fixed_steps};
 use super::{OscillatorSplit, SolveError, SolveStats};
 
 /// The flows of the linear part over h/2 and h for one (h, w2, c), and their second columns
@@ -76,10 +76,7 @@ impl PartialEq for FlowCache {
 /// Lawson RK4 with equal internal steps.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ExpRk4 {
-    /// Largest internal step; each interval is cut into equal steps no longer than this.
-    pub max_step: f64,
-    /// Most internal steps per interval.
-    pub max_steps: u64,
+    bound: StepBound,
     /// The flows of the last step size: communication steps are usually all alike, and the
     /// exponential and trigonometric functions would otherwise dominate a step's cost.
     flows: FlowCache,
@@ -88,8 +85,7 @@ pub struct ExpRk4 {
 impl ExpRk4 {
     pub fn new(max_step: f64, max_steps: u64) -> Self {
         ExpRk4 {
-            max_step,
-            max_steps,
+            bound: StepBound::new(max_step, max_steps),
             flows: FlowCache::default(),
         }
     }
@@ -127,7 +123,7 @@ impl ExpRk4 {
             f,
             cache: &mut self.flows.0,
         };
-        fixed_steps(t0, t1, self.max_step, self.max_steps, 4, y, &mut lawson)
+        fixed_steps(t0, t1, &self.bound, 4, y, &mut lawson)
     }
 }
 
