@@ -71,13 +71,22 @@ class Description:
         return f"I:{vr}={int(value)}"
 
 
+def _scene(d: Description) -> list[str]:
+    """Issue #29's physics: eta 2, phi 1, Constant damping at zeta 0.02."""
+    return [d.token("eta", 2.0), d.token("phi", 1.0), d.token("damping", "Constant"),
+            d.token("zeta", 0.02)]
+
+
+def _rk4(d: Description, step: float) -> list[str]:
+    """RK4 with internal steps of at most `step` (1 ms: one substep, 0.5 ms: two)."""
+    return [d.token("solver", "RK4"), d.token("solver.fixed_step", step)]
+
+
 def cases(d: Description):
     """[(name, tokens)]: issue #29's settings."""
-    phys = [d.token("eta", 2.0), d.token("phi", 1.0), d.token("damping", "Constant"),
-            d.token("zeta", 0.02)]
+    phys = _scene(d)
     fixed = [d.token("amplitude", "Fixed")]
-    rk4 = [d.token("solver", "RK4"), d.token("solver.fixed_step", 1e-3)]
-    rk4_n2 = [d.token("solver", "RK4"), d.token("solver.fixed_step", 5e-4)]
+    rk4, rk4_n2 = _rk4(d, 1e-3), _rk4(d, 5e-4)
     tight = [d.token("solver.tolerance", 1e-12)]
     nsd = [d.token("eta", 2.0), d.token("phi", 1.0)]
     return [("defaults", phys), ("defaults_Fixed", phys + fixed),
@@ -91,10 +100,9 @@ def c_cases(d: Description):
     """[(name, tokens)]: the careful C FMU (bench/c/tld_c.c) on the same scene: RK4 with one
     and with two substeps, DormandPrince45 at TLD.fmu's default tolerance and at the tight
     one."""
-    phys = [d.token("eta", 2.0), d.token("phi", 1.0), d.token("damping", "Constant"),
-            d.token("zeta", 0.02)]
-    return [("C_RK4_n1", phys + [d.token("solver", "RK4"), d.token("solver.fixed_step", 1e-3)]),
-            ("C_RK4_n2", phys + [d.token("solver", "RK4"), d.token("solver.fixed_step", 5e-4)]),
+    phys = _scene(d)
+    return [("C_RK4_n1", phys + _rk4(d, 1e-3)),
+            ("C_RK4_n2", phys + _rk4(d, 5e-4)),
             ("C_DP45_1e-10", phys + [d.token("solver.tolerance", 1e-10)]),
             ("C_DP45_1e-12", phys + [d.token("solver.tolerance", 1e-12)])]
 

@@ -103,9 +103,7 @@ pub(super) fn fixed_steps<const N: usize>(
         per_step,
     } = *bound;
     let span = t1 - t0;
-    // One step when the interval fits: the common case, kept free of the step count's
-    // integer-float conversions (u64 to f64 takes several instructions on x86-64) and of
-    // ceil (a libm call on baseline x86-64).
+    // One step when the interval fits: the common case, kept free of the step count.
     if span <= max_step && max_steps >= 1 {
         method.prepare(span);
         let z = method.step(t0, span, y);
